@@ -1,0 +1,2 @@
+"""hiconav: deployable hierarchical vision-language object navigation."""
+__version__ = "0.1.0"

@@ -1,0 +1,227 @@
+"""Shared value types of hiconav: poses, camera, frames, detections, goals, commands.
+
+Everything here is a frozen dataclass so that it can cross actor boundaries without copies or
+locks. Arrays stored in these types are made read-only on construction (``freeze``); code that
+needs to modify one must copy it first. This module must not import anything heavier than numpy.
+
+Frames and conventions (used everywhere in the project):
+- World frame: x east, y north, z up (metres), REP-103. The floor is z = 0.
+- Robot base: Pose2D (x, y, yaw) in the world frame, yaw counter-clockwise from +x (radians).
+- Camera frame: OpenCV (x right, y down, z forward). ``Frame.T_world_cam`` maps camera-frame
+  points to the world frame (4x4, float64).
+- Grids: cell (row i, col j) covers x in [ox + j*res, ox + (j+1)*res), y in [oy + i*res, ...).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+
+def freeze(array: np.ndarray | None) -> np.ndarray | None:
+    """Return ``array`` marked read-only (no copy) so it can be shared between threads."""
+    if array is None:
+        return None
+    array = np.asarray(array)
+    if array.flags.writeable:
+        array.flags.writeable = False
+    return array
+
+
+def wrap_angle(angle: float) -> float:
+    """Wrap an angle to [-pi, pi)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@dataclass(frozen=True)
+class Pose2D:
+    """Robot base pose in the world frame: position (m) and yaw (rad, CCW from +x)."""
+
+    x: float
+    y: float
+    yaw: float
+
+    @property
+    def xy(self) -> np.ndarray:
+        return np.array([self.x, self.y], dtype=np.float64)
+
+    def distance_to(self, other: Pose2D) -> float:
+        return math.hypot(other.x - self.x, other.y - self.y)
+
+
+@dataclass(frozen=True)
+class CameraIntrinsics:
+    """Pinhole intrinsics of a (width x height) image; ``K`` is the 3x3 matrix."""
+
+    width: int
+    height: int
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+
+    @staticmethod
+    def from_hfov(width: int, height: int, hfov_deg: float) -> CameraIntrinsics:
+        """Square pixels with the given horizontal field of view (Habitat's convention)."""
+        fx = (width / 2.0) / math.tan(math.radians(hfov_deg) / 2.0)
+        return CameraIntrinsics(width, height, fx, fx, width / 2.0, height / 2.0)
+
+    @property
+    def K(self) -> np.ndarray:
+        return np.array([[self.fx, 0, self.cx], [0, self.fy, self.cy], [0, 0, 1]], dtype=np.float64)
+
+    @property
+    def hfov(self) -> float:
+        """Horizontal field of view in radians."""
+        return 2.0 * math.atan2(self.width / 2.0, self.fx)
+
+
+def camera_pose_from_base(base: Pose2D, height: float, tilt: float = 0.0) -> np.ndarray:
+    """T_world_cam (4x4) of a forward-looking camera at ``height`` m above the base.
+
+    ``tilt`` is the pitch in radians, positive looking up. The camera's optical axis (+z_cam)
+    points along the base yaw; +x_cam points to the robot's right; +y_cam points down.
+    """
+    c, s = math.cos(base.yaw), math.sin(base.yaw)
+    forward = np.array([c, s, 0.0])
+    right = np.array([s, -c, 0.0])
+    up = np.array([0.0, 0.0, 1.0])
+    ct, st = math.cos(tilt), math.sin(tilt)
+    z_cam = ct * forward + st * up
+    y_cam = -(ct * up - st * forward)
+    x_cam = right
+    T = np.eye(4)
+    T[:3, 0], T[:3, 1], T[:3, 2] = x_cam, y_cam, z_cam
+    T[:3, 3] = [base.x, base.y, height]
+    return T
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One RGB-D observation.
+
+    rgb: (H, W, 3) uint8; depth: (H, W) float32 metres along the optical axis (0 or NaN =
+    no return); instances: (H, W) int32 ground-truth instance ids (simulator only, -1 = none;
+    only the oracle detector may read it). T_world_cam: (4, 4) float64 camera-to-world.
+    """
+
+    rgb: np.ndarray
+    depth: np.ndarray
+    intrinsics: CameraIntrinsics
+    T_world_cam: np.ndarray
+    base_pose: Pose2D
+    stamp: float
+    instances: np.ndarray | None = None
+    seq: int = 0
+
+    def __post_init__(self) -> None:
+        for name in ("rgb", "depth", "T_world_cam", "instances"):
+            freeze(getattr(self, name))
+
+
+@dataclass(frozen=True)
+class Detection:
+    """One detected object in an image.
+
+    box_xyxy: (4,) float pixels; mask: (H, W) bool or None; embedding: (D,) float32 or None.
+    ``source`` names the detector ("oracle", "owlvit", ...) so fallbacks stay visible.
+    """
+
+    label: str
+    score: float
+    box_xyxy: np.ndarray
+    mask: np.ndarray | None = None
+    embedding: np.ndarray | None = None
+    source: str = "unknown"
+    instance_id: int | None = None  # oracle only: the simulator's instance, for diagnostics
+
+    def __post_init__(self) -> None:
+        freeze(self.box_xyxy)
+        freeze(self.mask)
+        freeze(self.embedding)
+
+
+class DiscreteAction(enum.Enum):
+    """Habitat-style discrete actions."""
+
+    STOP = "stop"
+    MOVE_FORWARD = "move_forward"
+    TURN_LEFT = "turn_left"
+    TURN_RIGHT = "turn_right"
+    LOOK_UP = "look_up"
+    LOOK_DOWN = "look_down"
+
+
+@dataclass(frozen=True)
+class VelocityCommand:
+    """Body-frame velocity: v forward (m/s), omega yaw rate (rad/s, CCW positive)."""
+
+    v: float
+    omega: float
+    stamp: float = 0.0
+
+    @staticmethod
+    def zero(stamp: float = 0.0) -> VelocityCommand:
+        return VelocityCommand(0.0, 0.0, stamp)
+
+
+@dataclass(frozen=True)
+class Goal:
+    """A navigation goal for the control layer: a world position, optional facing yaw."""
+
+    x: float
+    y: float
+    yaw: float | None = None
+    tolerance: float = 0.25
+    kind: str = "frontier"  # "frontier" | "object" | "approach"
+    ref_id: int | None = None  # frontier id or object node id
+
+    @property
+    def xy(self) -> np.ndarray:
+        return np.array([self.x, self.y], dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class Frontier:
+    """A frontier cluster: free cells next to unknown space.
+
+    centroid / viewpoint: (2,) world metres; cells: (N, 2) int (row, col) grid cells.
+    ``viewpoint`` is a reachable free cell from which to observe the frontier.
+    """
+
+    id: int
+    centroid: np.ndarray
+    viewpoint: np.ndarray
+    size: int
+    cells: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int32))
+
+    def __post_init__(self) -> None:
+        freeze(self.centroid)
+        freeze(self.viewpoint)
+        freeze(self.cells)
+
+
+@dataclass(frozen=True)
+class TaskSpec:
+    """The decomposed instruction: target objects O_t and related objects O_r."""
+
+    instruction: str
+    targets: tuple[str, ...]
+    related: tuple[str, ...] = ()
+    attributes: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    relations: tuple[tuple[str, str, str], ...] = ()  # (subject, relation, object)
+    source: str = "offline"  # "offline" | "vlm"
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "instruction": self.instruction,
+            "targets": list(self.targets),
+            "related": list(self.related),
+            "attributes": {k: list(v) for k, v in self.attributes.items()},
+            "relations": [list(r) for r in self.relations],
+            "source": self.source,
+        }
