@@ -13,7 +13,7 @@ OUT ?= out/demo
 
 setup: $(STAMP)
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml setup.py
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	# torch first, pinned: the CPU build on disk; a later unpinned resolve would pull a CUDA build
 	$(BIN)/python -m pip install --quiet "torch==2.13.0"
