@@ -28,6 +28,7 @@ app = typer.Typer(
 # (subcommand, module, function): the module owns the options and the implementation.
 SUBCOMMANDS: list[tuple[str, str, str]] = [
     ("sim", "hiconav.sim.cli", "sim"),
+    ("vehicle", "hiconav.drivers.cli", "vehicle"),
 ]
 
 
