@@ -10,7 +10,6 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "drivers"))
-sys.path.insert(0, "/work/main/tests/drivers")
 from driver_helpers import UdpRelay, free_udp_port, test_profile, wait_until  # noqa: E402
 
 from hiconav.drivers.base import FailsafeState  # noqa: E402
