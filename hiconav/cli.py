@@ -29,6 +29,7 @@ app = typer.Typer(
 SUBCOMMANDS: list[tuple[str, str, str]] = [
     ("sim", "hiconav.sim.cli", "sim"),
     ("vehicle", "hiconav.drivers.cli", "vehicle"),
+    ("parse", "hiconav.reasoning.cli", "parse"),
 ]
 
 

@@ -1,0 +1,70 @@
+"""``hiconav parse``: decompose an instruction into targets and related objects, print JSON.
+
+Uses the offline parser unless a VLM endpoint is configured (``--base-url``, the environment
+variable ``HICONAV_VLM_BASE_URL``, or ``reasoning.vlm.base_url`` in the settings); the printed
+JSON names the backend that answered in ``source``. Heavy imports stay inside the function.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+
+import typer
+
+
+def parse(
+    instruction: str = typer.Argument(..., help='The instruction, e.g. "find the blue mug beside the sink".'),
+    base_url: str = typer.Option(None, "--base-url", help="OpenAI-compatible endpoint, e.g. "
+                                 "http://127.0.0.1:8080/v1 (default: $HICONAV_VLM_BASE_URL or settings)."),
+    model: str = typer.Option(None, "--model", help="Model name sent to the endpoint."),
+    offline: bool = typer.Option(False, "--offline",
+                                 help="Use the offline parser even if an endpoint is set."),
+    no_json_mode: bool = typer.Option(False, "--no-json-mode",
+                                      help="Do not send response_format json_object."),
+    timeout: float = typer.Option(None, "--timeout", help="Request timeout in seconds."),
+    embeddings: bool = typer.Option(True, "--embeddings/--no-embeddings",
+                                    help="Map unknown nouns to the vocabulary with MiniLM similarity."),
+) -> None:
+    """Decompose an instruction into target and related objects (printed as JSON)."""
+    from hiconav.reasoning.config import ReasoningConfig
+    from hiconav.reasoning.decompose import decompose_instruction, default_similarity
+
+    config = _load_config()
+    vlm = config.vlm.model_dump()
+    url = base_url or os.environ.get("HICONAV_VLM_BASE_URL") or vlm.get("base_url")
+    vlm["base_url"] = None if offline else url
+    if model:
+        vlm["model"] = model
+    if no_json_mode:
+        vlm["json_mode"] = False
+    if timeout:
+        vlm["timeout_s"] = timeout
+    data = config.model_dump()
+    data["vlm"] = vlm
+    if offline:
+        data["backend"] = "offline"
+    config = ReasoningConfig.model_validate(data)
+    similarity = default_similarity() if embeddings else (lambda a, b: 0.0)
+    task = decompose_instruction(instruction, config, similarity=similarity)
+    out = task.to_json()
+    if task.source == "offline":
+        out["note"] = ("offline rule-based parser (no VLM endpoint configured)" if not config.use_vlm()
+                       else "FALLBACK: the VLM failed; offline rule-based parser (see log)")
+    typer.echo(json.dumps(out))
+
+
+def _load_config():
+    """ReasoningConfig from hiconav.settings when the lead's settings module provides one."""
+    from hiconav.reasoning.config import ReasoningConfig
+
+    try:
+        from hiconav import settings  # type: ignore[attr-defined]
+
+        loaded = settings.load_settings()
+        reasoning = getattr(loaded, "reasoning", None)
+        if isinstance(reasoning, ReasoningConfig):
+            return reasoning
+    except (ImportError, AttributeError):
+        pass
+    return ReasoningConfig()

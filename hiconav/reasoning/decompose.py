@@ -1,0 +1,763 @@
+"""Instruction decomposition: instruction -> TaskSpec (target set O_t, related set O_r).
+
+Paper, section "Deep Reasoning", paragraph "Subgraph Decomposition": at the start of a task the
+instruction is decomposed into the target objects O_t (whose observation completes the task) and
+the related objects O_r (strongly associated with the target, cues to where it is).
+
+Two backends:
+- ``vlm``: the OpenAI-compatible chat API (``VLMClient``), asked for JSON
+  ``{"targets": [...], "related": [...], "attributes": {...}, "relations": [...]}``; the reply
+  is validated (``replies.parse_decomposition``) and its labels mapped to the vocabulary.
+- ``offline``: a small rule-based parser (spaCy is not available) with an explicit lexicon:
+  it strips imperative phrases and determiners, splits relation phrases ("beside", "next to",
+  "in front of", "between ... and ..."), collects attributes (colours, materials, sizes,
+  shapes), maps head nouns to the vocabulary by synonyms, then by embedding similarity (an
+  injected ``similarity(a, b)``; the default is the MiniLM embedder, loaded only when a noun is
+  not in the lexicon), and adds related objects from co-occurrence priors. Its TaskSpec says
+  ``source="offline"``.
+
+This module does not talk to the network itself (the client does) and never produces commands.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+
+from hiconav.errors import HiconavError
+from hiconav.reasoning.config import ReasoningConfig
+from hiconav.types import TaskSpec
+
+log = logging.getLogger(__name__)
+
+Similarity = Callable[[str, str], float]
+
+
+class InstructionError(HiconavError):
+    """An instruction that names no object, or a decomposition that failed."""
+
+
+# ---------------------------------------------------------------------------- vocabulary
+# The simulator's categories: ProcTHOR objectTypes in snake case with its aliases (tv, plant,
+# armchair, tv_stand, fridge, sofa; hiconav.sim.procthor.CATEGORY_ALIASES), the Gibson ObjectNav
+# categories (sofa, plant, tv, dining_table, oven, sink, fridge, book, clock, vase, cup, bottle)
+# and a few common household objects that neither data set has (bathtub, shower, cabinet, ...).
+OBJECTNAV_CATEGORIES: tuple[str, ...] = ("chair", "sofa", "plant", "bed", "toilet", "tv")
+DEFAULT_VOCABULARY: tuple[str, ...] = (
+    "alarm_clock", "apple", "armchair", "baseball_bat", "basket_ball", "bathtub", "bed", "blinds",
+    "book", "boots", "bottle", "bowl", "box", "bread", "butter_knife", "cabinet", "candle", "cart",
+    "cd", "cell_phone", "chair", "clock", "cloth", "clothes_dryer", "coffee_machine",
+    "coffee_table", "counter_top", "credit_card", "cup", "curtains", "desk", "desk_lamp", "desktop",
+    "dining_table", "dish_sponge", "dog_bed", "door", "dresser", "dumbbell", "egg", "faucet",
+    "floor_lamp", "footstool", "fork", "fridge", "garbage_bag", "garbage_can", "hand_towel",
+    "kettle", "key_chain", "knife", "ladle", "laptop", "laundry_hamper",
+    "lettuce", "light_switch", "microwave", "mirror", "mug", "newspaper", "ottoman", "oven",
+    "painting", "pan", "paper_towel_roll", "pen", "pencil", "pepper_shaker", "pillow", "plant",
+    "plate", "plunger", "pot", "potato", "remote_control", "rug", "safe", "salt_shaker",
+    "scrub_brush", "shelving_unit", "shower", "shower_curtain", "side_table", "sink", "soap_bar",
+    "soap_bottle", "sofa", "spatula", "spoon", "spray_bottle", "statue", "stool", "stove",
+    "teddy_bear", "tennis_racket", "tissue_box", "toaster", "toilet", "toilet_paper", "tomato",
+    "towel", "tv", "tv_stand", "vacuum_cleaner", "vase", "washing_machine", "watch",
+    "watering_can", "window", "wine_bottle",
+)
+
+# Synonym groups: phrase -> candidate labels in order of preference; the first candidate in the
+# active vocabulary wins (so "fridge" resolves to "refrigerator" in a vocabulary that uses that).
+_SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
+    ("sofa", "couch", "settee", "loveseat", "love seat", "sectional", "sofa bed"): ("sofa", "couch"),
+    ("tv", "television", "tv set", "television set", "telly", "flat screen", "flatscreen tv",
+     "flat screen tv", "tv screen", "television screen", "smart tv"): ("tv", "television"),
+    ("plant", "potted plant", "house plant", "houseplant", "pot plant", "indoor plant",
+     "flower pot", "flowerpot", "planter", "flowers", "flower"): ("plant", "potted_plant", "house_plant"),
+    ("fridge", "refrigerator", "freezer", "icebox"): ("fridge", "refrigerator"),
+    ("dining table", "dinner table", "kitchen table", "dining-table", "table", "eating table"):
+        ("table", "dining_table"),
+    ("side table", "nightstand", "night stand", "bedside table", "night table", "end table",
+     "bedside cabinet"): ("side_table", "nightstand"),
+    ("coffee table", "cocktail table", "tea table", "low table"): ("coffee_table",),
+    ("desk", "writing desk", "office desk", "computer desk", "work desk"): ("desk",),
+    ("chair", "dining chair", "kitchen chair", "office chair", "desk chair", "wooden chair",
+     "seat"): ("chair",),
+    ("armchair", "arm chair", "recliner", "easy chair", "lounge chair", "accent chair"):
+        ("armchair", "arm_chair", "chair"),
+    ("bed", "double bed", "single bed", "king bed", "queen bed", "bunk bed"): ("bed",),
+    ("toilet", "wc", "commode", "loo", "water closet", "toilet bowl"): ("toilet",),
+    ("sink", "washbasin", "wash basin", "basin", "kitchen sink", "bathroom sink", "handbasin"):
+        ("sink",),
+    ("bathtub", "bath tub", "tub", "bath"): ("bathtub",),
+    ("shower", "shower stall", "shower cabin"): ("shower",),
+    ("garbage can", "trash can", "trashcan", "bin", "trash bin", "garbage bin", "wastebasket",
+     "waste basket", "dustbin", "rubbish bin", "waste bin"): ("garbage_can",),
+    ("shelving unit", "shelf", "shelves", "bookshelf", "bookcase", "book shelf", "shelving",
+     "rack"): ("shelving_unit", "shelf"),
+    ("cell phone", "cellphone", "phone", "mobile phone", "smartphone", "mobile", "smart phone"):
+        ("cell_phone",),
+    ("remote control", "remote", "tv remote", "clicker"): ("remote_control",),
+    ("painting", "picture", "artwork", "poster", "framed picture", "portrait", "canvas"): ("painting",),
+    ("counter top", "countertop", "counter", "kitchen counter", "worktop", "kitchen island",
+     "island"): ("counter_top", "counter"),
+    ("floor lamp", "standing lamp", "lamp", "light"): ("floor_lamp", "lamp"),
+    ("desk lamp", "table lamp", "reading lamp", "bedside lamp"): ("desk_lamp", "lamp"),
+    ("coffee machine", "coffee maker", "espresso machine", "coffeemaker"): ("coffee_machine",),
+    ("washing machine", "washer", "laundry machine"): ("washing_machine",),
+    ("clothes dryer", "dryer", "tumble dryer"): ("clothes_dryer",),
+    ("dresser", "chest of drawers", "drawers", "chest", "wardrobe", "closet"): ("dresser",),
+    ("alarm clock",): ("alarm_clock", "clock"),
+    ("clock", "wall clock"): ("clock",),
+    ("teddy bear", "teddy", "stuffed animal", "plush toy", "soft toy"): ("teddy_bear",),
+    ("stool", "bar stool", "step stool"): ("stool",),
+    ("ottoman", "pouf", "footstool", "foot stool", "footrest"): ("ottoman", "footstool"),
+    ("oven", "cooker", "range"): ("oven", "stove"),
+    ("stove", "stovetop", "hob", "cooktop", "stove burner"): ("stove", "oven"),
+    ("microwave", "microwave oven"): ("microwave",),
+    ("laptop", "notebook computer", "laptop computer", "computer", "macbook"): ("laptop",),
+    ("mug", "coffee mug", "tea mug"): ("mug", "cup"),
+    ("cup", "teacup", "tea cup", "coffee cup", "glass", "drinking glass"): ("cup", "mug"),
+    ("bottle", "water bottle"): ("bottle",),
+    ("wine bottle", "bottle of wine"): ("wine_bottle", "bottle"),
+    ("vase", "flower vase"): ("vase",),
+    ("book", "novel", "books"): ("book",),
+    ("pillow", "cushion", "throw pillow"): ("pillow",),
+    ("towel", "bath towel"): ("towel",),
+    ("hand towel",): ("hand_towel", "towel"),
+    ("tv stand", "tv cabinet", "media console", "entertainment center", "tv unit",
+     "television stand"): ("tv_stand",),
+    ("garbage bag", "trash bag", "bin bag"): ("garbage_bag",),
+    ("laundry hamper", "laundry basket", "hamper", "clothes basket"): ("laundry_hamper",),
+    ("toilet paper", "toilet roll", "loo roll", "bathroom tissue"): ("toilet_paper",),
+    ("paper towel roll", "paper towel", "kitchen roll", "paper towels"): ("paper_towel_roll",),
+    ("tissue box", "tissues", "kleenex"): ("tissue_box",),
+    ("soap bottle", "soap dispenser", "hand soap", "liquid soap"): ("soap_bottle",),
+    ("soap bar", "soap", "bar of soap"): ("soap_bar",),
+    ("faucet", "tap"): ("faucet",),
+    ("pot", "cooking pot", "saucepan", "stockpot"): ("pot",),
+    ("pan", "frying pan", "skillet", "frypan"): ("pan",),
+    ("kettle", "tea kettle", "electric kettle"): ("kettle",),
+    ("plate", "dish", "dinner plate"): ("plate",),
+    ("bowl", "salad bowl", "cereal bowl"): ("bowl",),
+    ("window", "windows"): ("window",),
+    ("door", "doorway", "front door"): ("door",),
+    ("mirror", "wall mirror"): ("mirror",),
+    ("rug", "carpet", "mat"): ("rug",),
+    ("curtains", "curtain", "drapes"): ("curtains",),
+    ("cabinet", "cupboard", "kitchen cabinet"): ("cabinet",),
+    ("dog bed", "pet bed"): ("dog_bed",),
+    ("vacuum cleaner", "vacuum", "hoover"): ("vacuum_cleaner",),
+    ("box", "cardboard box", "carton"): ("box",),
+    ("statue", "sculpture", "figurine"): ("statue",),
+    ("candle", "candles"): ("candle",),
+    ("watering can",): ("watering_can",),
+    ("spray bottle",): ("spray_bottle",),
+    ("basketball", "basket ball"): ("basket_ball",),
+    ("baseball bat",): ("baseball_bat",),
+    ("tennis racket", "tennis racquet", "racket"): ("tennis_racket",),
+    ("dumbbell", "weight", "weights"): ("dumbbell",),
+    ("newspaper", "paper", "magazine"): ("newspaper",),
+    ("key chain", "keychain", "keys", "key"): ("key_chain",),
+    ("credit card", "bank card"): ("credit_card",),
+    ("desktop", "desktop computer", "pc", "monitor", "computer monitor"): ("desktop",),
+}
+
+ROOMS: dict[str, str] = {
+    "kitchen": "kitchen", "bedroom": "bedroom", "bed room": "bedroom", "bathroom": "bathroom",
+    "bath room": "bathroom", "restroom": "bathroom", "washroom": "bathroom",
+    "living room": "living_room", "livingroom": "living_room", "lounge": "living_room",
+    "family room": "living_room", "sitting room": "living_room", "dining room": "dining_room",
+    "hallway": "hallway", "hall": "hallway", "corridor": "hallway", "office": "office",
+    "study": "office", "laundry room": "laundry_room", "laundry": "laundry_room",
+    "garage": "garage", "nursery": "bedroom", "guest room": "bedroom", "master bedroom": "bedroom",
+}
+
+# Co-occurrence priors (common sense of household layouts): label -> related objects, most
+# telling first. Entries not in the active vocabulary are dropped.
+COOCCURRENCE: dict[str, tuple[str, ...]] = {
+    "bed": ("side_table", "dresser", "pillow", "desk_lamp", "alarm_clock"),
+    "sofa": ("tv", "coffee_table", "armchair", "pillow", "floor_lamp"),
+    "chair": ("dining_table", "desk", "coffee_table"),
+    "armchair": ("sofa", "coffee_table", "floor_lamp", "tv"),
+    "toilet": ("sink", "bathtub", "toilet_paper", "shower", "towel"),
+    "tv": ("sofa", "tv_stand", "armchair", "coffee_table", "remote_control"),
+    "plant": ("sofa", "window", "side_table", "coffee_table", "vase"),
+    "dining_table": ("chair", "plate", "bowl", "vase"),
+    "table": ("chair", "plate", "bowl"),
+    "sink": ("faucet", "counter_top", "toilet", "soap_bottle", "fridge"),
+    "fridge": ("counter_top", "sink", "microwave", "stove", "oven"),
+    "oven": ("stove", "counter_top", "fridge", "sink"),
+    "stove": ("oven", "pan", "pot", "counter_top"),
+    "microwave": ("counter_top", "fridge", "toaster", "coffee_machine"),
+    "mug": ("coffee_machine", "counter_top", "sink", "dining_table"),
+    "cup": ("counter_top", "sink", "dining_table", "coffee_machine"),
+    "bottle": ("counter_top", "fridge", "dining_table"),
+    "wine_bottle": ("dining_table", "counter_top", "fridge"),
+    "laptop": ("desk", "chair", "desk_lamp"),
+    "desk": ("chair", "laptop", "desk_lamp"),
+    "book": ("shelving_unit", "desk", "side_table"),
+    "clock": ("dresser", "side_table", "shelving_unit"),
+    "alarm_clock": ("side_table", "bed", "dresser"),
+    "vase": ("side_table", "dining_table", "coffee_table"),
+    "toaster": ("counter_top", "microwave", "coffee_machine"),
+    "coffee_machine": ("counter_top", "mug", "toaster"),
+    "kettle": ("stove", "counter_top", "mug"),
+    "pillow": ("bed", "sofa", "armchair"),
+    "remote_control": ("tv", "sofa", "coffee_table"),
+    "bathtub": ("toilet", "sink", "towel", "shower_curtain"),
+    "towel": ("sink", "toilet", "bathtub"),
+    "side_table": ("bed", "sofa", "desk_lamp"),
+    "dresser": ("bed", "mirror", "side_table"),
+    "coffee_table": ("sofa", "armchair", "tv"),
+    "washing_machine": ("clothes_dryer", "laundry_hamper"),
+    "garbage_can": ("counter_top", "sink", "desk"),
+    "plate": ("dining_table", "counter_top", "sink"),
+    "bowl": ("dining_table", "counter_top", "sink"),
+    "painting": ("sofa", "bed", "dining_table"),
+    "floor_lamp": ("sofa", "armchair", "side_table"),
+    "teddy_bear": ("bed", "pillow"),
+    "tv_stand": ("tv", "sofa"),
+    "shelving_unit": ("book", "vase"),
+    "cell_phone": ("side_table", "desk", "sofa"),
+    "stool": ("counter_top", "dining_table"),
+}
+ROOM_PRIORS: dict[str, tuple[str, ...]] = {
+    "kitchen": ("fridge", "counter_top", "sink", "stove", "microwave"),
+    "bedroom": ("bed", "dresser", "side_table"),
+    "bathroom": ("toilet", "sink", "bathtub"),
+    "living_room": ("sofa", "tv", "coffee_table"),
+    "dining_room": ("dining_table", "chair"),
+    "office": ("desk", "chair", "laptop"),
+    "laundry_room": ("washing_machine", "clothes_dryer"),
+}
+
+# ---------------------------------------------------------------------------- word lists
+COLOURS = frozenset([
+    "red", "orange", "yellow", "green", "blue", "purple", "violet", "pink", "brown", "black",
+    "white", "grey", "gray", "silver", "gold", "golden", "beige", "cream", "navy", "teal",
+    "turquoise", "maroon", "tan", "ivory", "khaki", "olive", "magenta", "cyan", "lilac", "lavender",
+    "colorful", "colourful", "multicolored", "multicoloured",
+])
+MATERIALS = frozenset([
+    "wooden", "wood", "metal", "metallic", "glass", "plastic", "leather", "fabric", "ceramic",
+    "marble", "stone", "steel", "iron", "porcelain", "wicker", "velvet", "cotton", "paper",
+    "cardboard", "rattan", "bamboo", "chrome", "brass", "copper", "woolen", "wool", "upholstered",
+])
+SIZES = frozenset([
+    "small", "little", "tiny", "large", "big", "huge", "tall", "short", "long", "wide", "narrow",
+    "medium", "mini", "giant", "low", "high",
+])
+SHAPES = frozenset([
+    "round", "square", "rectangular", "circular", "oval",
+])
+STATES = frozenset([
+    "open", "closed", "empty", "full", "old", "new", "modern", "vintage", "striped", "patterned",
+    "plain", "soft", "comfortable", "dark", "light", "bright", "shiny", "broken", "dirty", "clean",
+    "folded", "unmade", "made", "single", "double", "leftmost", "rightmost", "far", "near",
+    "nearest", "closest", "nearby", "hanging", "framed", "electric",
+])
+ATTRIBUTE_WORDS = COLOURS | MATERIALS | SIZES | SHAPES | STATES
+
+DETERMINERS = frozenset([
+    "a", "an", "the", "some", "any", "my", "your", "our", "their", "his", "her", "its", "this",
+    "that", "these", "those", "one", "another", "each", "every", "there", "here", "please", "kind",
+    "sort", "type", "very", "really", "quite", "rather",
+])
+
+# Leading phrases to strip (longest first), repeated until none applies.
+IMPERATIVES: tuple[str, ...] = tuple(sorted("""
+please|can you|could you|would you|will you|i want you to|i need you to|i'd like you to|
+i would like you to|you should|try to|help me|let's|let us|now|then|and|first|
+find|find me|locate|look for|search for|search|seek|spot|detect|identify|look at|
+go to|go find|go and find|go towards|go toward|go near|go over to|go|navigate to|navigate towards|
+navigate|move to|move towards|walk to|walk towards|walk over to|head to|head towards|head for|
+get to|get close to|get near|get me to|take me to|bring me to|lead me to|drive to|approach|
+reach|visit|show me|where is|where's|where are|i'm looking for|i am looking for|
+i want to find|i need to find|i need|i want|i lost|we need|
+stop at|stop by|stop near|go stand by|stand next to|stand by|end up at|come to|
+the target is|target|your goal is|the goal is|goal|object|it is|it's|there is|there's|
+""".replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
+
+# Relation phrases -> canonical relation (longest match first).
+RELATIONS: dict[str, str] = {
+    "in front of": "in front of", "to the left of": "left of", "on the left of": "left of",
+    "left of": "left of", "to the right of": "right of", "on the right of": "right of",
+    "right of": "right of", "on top of": "on", "next to": "next to", "close to": "near",
+    "adjacent to": "next to", "near to": "near", "beside": "next to", "besides": "next to",
+    "by": "next to", "alongside": "next to", "near": "near", "nearby": "near",
+    "on": "on", "onto": "on", "atop": "on", "upon": "on", "under": "under",
+    "underneath": "under", "beneath": "under", "below": "below", "above": "above",
+    "over": "above", "behind": "behind", "in back of": "behind", "inside": "in",
+    "inside of": "in", "within": "in", "in": "in", "at": "at", "between": "between",
+    "among": "between", "with": "with", "against": "against", "opposite": "opposite",
+    "opposite to": "opposite", "across from": "opposite", "facing": "facing",
+    "around": "near", "from": "near",
+}
+_RELATION_KEYS = sorted(RELATIONS, key=lambda p: -len(p.split()))
+# Filler between a noun and its relation ("the mug that is on the table").
+FILLERS = frozenset([
+    "that", "which", "who", "is", "are", "was", "sits", "sit", "sitting", "located", "placed",
+    "standing", "stands", "lying", "lies", "positioned", "found", "kept", "hung", "hanging", "set",
+    "resting", "rests", "there", "it's", "its", "just", "right", "directly", "somewhere", "usually",
+    "probably",
+])
+PRONOUNS = frozenset([
+    "it", "its", "it's", "itself", "they", "them", "this", "that", "which", "one", "ones",
+])
+_IRREGULAR_PLURALS = {"knives": "knife", "shelves": "shelves", "leaves": "leaf", "glasses": "glass",
+                      "mice": "mouse", "people": "person", "feet": "foot", "dishes": "dish",
+                      "boxes": "box", "benches": "bench", "couches": "couch", "watches": "watch",
+                      "brushes": "brush", "glass": "glass", "tv": "tv", "bus": "bus"}
+
+
+def _singular(word: str) -> str:
+    if word in _IRREGULAR_PLURALS:
+        return _IRREGULAR_PLURALS[word]
+    if len(word) <= 3 or word.endswith(("ss", "us", "is", "ous")):
+        return word
+    if word.endswith("ies"):
+        return word[:-3] + "y"
+    if word.endswith(("ches", "shes", "xes", "zes", "sses")):
+        return word[:-2]
+    if word.endswith("s"):
+        return word[:-1]
+    return word
+
+
+def _spaced(label: str) -> str:
+    return label.replace("_", " ").strip().lower()
+
+
+@dataclass
+class Lexicon:
+    """Phrase -> vocabulary label, built from the vocabulary and the synonym groups."""
+
+    vocabulary: tuple[str, ...]
+    phrases: dict[str, str] = field(default_factory=dict)
+    max_words: int = 1
+
+    @classmethod
+    def build(cls, vocabulary: Iterable[str]) -> Lexicon:
+        vocab = tuple(dict.fromkeys(v.strip().lower() for v in vocabulary if v and v.strip()))
+        lex = cls(vocab)
+        in_vocab = set(vocab)
+        for phrases, candidates in _SYNONYMS.items():
+            target = next((c for c in candidates if c in in_vocab), None)
+            if target is None:
+                continue
+            for p in phrases:
+                lex.phrases.setdefault(p, target)
+        for label in vocab:  # the vocabulary's own names win over synonyms
+            lex.phrases[_spaced(label)] = label
+            lex.phrases[label] = label
+        lex.max_words = max(len(p.split()) for p in lex.phrases) if lex.phrases else 1
+        return lex
+
+    def lookup(self, phrase: str) -> str | None:
+        phrase = " ".join(phrase.split())
+        if phrase in self.phrases:
+            return self.phrases[phrase]
+        words = phrase.split()
+        if words:
+            singular = " ".join(words[:-1] + [_singular(words[-1])])
+            return self.phrases.get(singular)
+        return None
+
+
+@dataclass(frozen=True)
+class NounPhrase:
+    """A parsed noun phrase: its label (vocabulary or open-vocabulary), attributes, words."""
+
+    label: str
+    attributes: tuple[str, ...]
+    text: str
+    in_vocabulary: bool
+    room: str | None = None
+
+
+class OfflineParser:
+    """Rule-based instruction parser (the offline reasoner's decomposition; a labelled fallback
+    to the VLM backend).
+
+    similarity: ``similarity(a, b) -> float`` in [-1, 1] used to map unknown nouns to the
+    vocabulary (threshold ``threshold``); None = no embedding step (synonyms only).
+    """
+
+    def __init__(self, vocabulary: Sequence[str] | None = None, similarity: Similarity | None = None,
+                 *, threshold: float = 0.62, max_related: int = 6) -> None:
+        self.lexicon = Lexicon.build(vocabulary or DEFAULT_VOCABULARY)
+        self.vocabulary = self.lexicon.vocabulary
+        self.similarity = similarity
+        self.threshold = threshold
+        self.max_related = max_related
+        self._sim_cache: dict[str, tuple[str | None, float]] = {}
+
+    # ------------------------------------------------------------------ public
+    def parse(self, instruction: str) -> TaskSpec:
+        """Decompose one instruction (English) into a TaskSpec with source="offline"."""
+        if not isinstance(instruction, str) or not instruction.strip():
+            raise InstructionError("the instruction is empty", field="instruction")
+        sentences = self._sentences(instruction)
+        targets: list[NounPhrase] = []
+        related: list[NounPhrase] = []
+        relations: list[tuple[str, str, str]] = []
+        rooms: list[str] = []
+        attributes: dict[str, list[str]] = {}
+
+        for si, sentence in enumerate(sentences):
+            words = sentence.split()
+            refers_to_target = bool(targets) and self._refers_to_target(words, targets)
+            words = self._strip_imperatives(words)
+            if not words:
+                continue
+            segments = self._segments(words)
+            head_words, rest = segments[0][1], segments[1:]
+            if refers_to_target:
+                subjects = [targets[0]]
+                # "It is white and wooden." -> attributes of the target
+                for w in head_words:
+                    if w in ATTRIBUTE_WORDS:
+                        attributes.setdefault(targets[0].label, []).append(w)
+                leading = [w for w in head_words if w not in ATTRIBUTE_WORDS and w not in FILLERS
+                           and w not in DETERMINERS and w not in PRONOUNS and w not in ("and", ",")]
+                extra = self._noun_phrases(leading) if leading else []
+                related += [p for p in extra if p.room is None]
+                rooms += [p.room for p in extra if p.room]
+            else:
+                subjects = self._noun_phrases(head_words)
+                if not subjects:
+                    continue
+                room_only = [p for p in subjects if p.room]
+                objs = [p for p in subjects if p.room is None]
+                rooms += [p.room for p in room_only]
+                if not targets and objs:
+                    targets += objs
+                else:
+                    related += objs
+                if not objs:
+                    subjects = targets[:1]
+            previous = subjects
+            after_comma = bool(head_words) and head_words[-1] == ","
+            for relation, np_words in rest:
+                if after_comma:  # ", to the right of the fridge": back to the sentence's subject
+                    previous = subjects
+                after_comma = bool(np_words) and np_words[-1] == ","
+                if np_words and all(w in PRONOUNS or w == "," for w in np_words):
+                    # "... in front of it": "it" is the target
+                    if targets and previous and previous[0].label != targets[0].label:
+                        relations.append((previous[0].label, relation, targets[0].label))
+                    continue
+                phrases = self._noun_phrases(np_words)
+                for p in phrases:
+                    for subj in previous[:1]:
+                        relations.append((subj.label, relation, p.room or p.label))
+                    if p.room:
+                        rooms.append(p.room)
+                    else:
+                        related.append(p)
+                if phrases and relation != "between":
+                    objs = [p for p in phrases if p.room is None]
+                    previous = objs or previous
+            for p in subjects + related:
+                if p.attributes:
+                    attributes.setdefault(p.label, [])
+                    attributes[p.label] += [a for a in p.attributes if a not in attributes[p.label]]
+
+        if not targets:
+            raise InstructionError(f"no object found in the instruction {instruction!r}",
+                                   field="instruction")
+        target_labels = list(dict.fromkeys(p.label for p in targets))
+        for room in dict.fromkeys(rooms):
+            rel = (target_labels[0], "in", room)
+            if rel not in relations:
+                relations.append(rel)
+        related_labels = [p.label for p in related]
+        for t in target_labels:
+            related_labels += list(self._priors(t))
+        for room in dict.fromkeys(rooms):
+            related_labels += [r for r in ROOM_PRIORS.get(room, ()) if r in self.lexicon.vocabulary]
+        related_out = [r for r in dict.fromkeys(related_labels) if r not in target_labels]
+        explicit = [p.label for p in related]
+        keep = max(self.max_related, len(set(explicit)))
+        related_out = related_out[:keep]
+        attrs = {k: tuple(dict.fromkeys(v)) for k, v in attributes.items() if v}
+        return TaskSpec(instruction=instruction.strip(), targets=tuple(target_labels),
+                        related=tuple(related_out), attributes=attrs,
+                        relations=tuple(dict.fromkeys(relations)), source="offline")
+
+    def canonical(self, phrase: str) -> tuple[str, bool]:
+        """Map a noun phrase to a vocabulary label: (label, in_vocabulary).
+
+        Order: lexicon (synonyms, plural), embedding similarity >= threshold, else the phrase
+        itself in snake case (open vocabulary).
+        """
+        phrase = " ".join(phrase.lower().replace("_", " ").split())
+        hit = self.lexicon.lookup(phrase)
+        if hit is not None:
+            return hit, True
+        best, score = self._most_similar(phrase)
+        if best is not None and score >= self.threshold:
+            return best, True
+        words = phrase.split()
+        if words:
+            words[-1] = _singular(words[-1])
+        return "_".join(words), False
+
+    # ------------------------------------------------------------------ steps
+    @staticmethod
+    def _sentences(text: str) -> list[str]:
+        text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
+        text = re.sub(r"[\"“”()\[\]{}:]", " ", text)
+        parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+and\s+(?=(?:find|look|go|search|locate)\b)"
+                         r"|\s+and\s+(?=(?:find|look for|search for|locate)\b)", text)
+        out = []
+        for part in parts:
+            part = re.sub(r"[^a-z0-9' \-,]", " ", part)
+            part = part.replace(",", " , ").replace("-", " ")
+            part = " ".join(part.split())
+            if part:
+                out.append(part)
+        return out
+
+    @staticmethod
+    def _strip_imperatives(words: list[str]) -> list[str]:
+        changed = True
+        while changed and words:
+            changed = False
+            text = " ".join(words)
+            for phrase in IMPERATIVES:
+                if text == phrase or text.startswith(phrase + " "):
+                    words = words[len(phrase.split()):]
+                    changed = True
+                    break
+            while words and (words[0] in DETERMINERS or words[0] == ","):
+                words = words[1:]
+                changed = True
+        return words
+
+    def _refers_to_target(self, words: list[str], targets: list[NounPhrase]) -> bool:
+        if words and words[0] in ("it", "it's", "its", "this", "which"):
+            return True
+        text = " " + " ".join(words) + " "
+        for t in targets:
+            name = _spaced(t.label)
+            if re.match(rf"^ (?:the |this |that )?{re.escape(name)} (?:is|are|sits|stands|lies)\b", text):
+                return True
+        return False
+
+    def _segments(self, words: list[str]) -> list[tuple[str, list[str]]]:
+        """Split at relation phrases: [("", head words), (relation, words), ...]."""
+        segments: list[tuple[str, list[str]]] = [("", [])]
+        i = 0
+        while i < len(words):
+            matched = None
+            for phrase in _RELATION_KEYS:
+                n = len(phrase.split())
+                if words[i:i + n] == phrase.split():
+                    matched = (phrase, n)
+                    break
+            if matched and not self._relation_is_part_of_name(words, i, matched[1]):
+                phrase, n = matched
+                segments.append((RELATIONS[phrase], []))
+                i += n
+                continue
+            segments[-1][1].append(words[i])
+            i += 1
+        # "between the sofa and the tv": keep both in one segment; drop fillers everywhere.
+        cleaned = []
+        for rel, seg in segments:
+            seg = [w for w in seg if w not in FILLERS]
+            if rel or seg:
+                cleaned.append((rel, seg))
+        if not cleaned or cleaned[0][0] != "":
+            cleaned.insert(0, ("", []))
+        return cleaned
+
+    def _relation_is_part_of_name(self, words: list[str], i: int, n: int) -> bool:
+        """True when a relation word belongs to a name ("chest of drawers", "bar of soap")."""
+        for length in range(min(self.lexicon.max_words, 4), 1, -1):
+            for start in range(max(0, i - length + 1), i + 1):
+                span = words[start:start + length]
+                if len(span) == length and start + length > i and " ".join(span) in self.lexicon.phrases:
+                    return True
+        return False
+
+    def _noun_phrases(self, words: list[str]) -> list[NounPhrase]:
+        """Split on and/or/commas and parse each part."""
+        parts: list[list[str]] = [[]]
+        for w in words:
+            if w in ("and", "or", ",", "&", "nor", "plus"):
+                parts.append([])
+            else:
+                parts[-1].append(w)
+        out = []
+        for part in parts:
+            np_ = self._noun_phrase(part)
+            if np_ is not None:
+                out.append(np_)
+        return out
+
+    def _noun_phrase(self, words: list[str]) -> NounPhrase | None:
+        words = [w for w in words if w not in DETERMINERS and w not in FILLERS and w not in PRONOUNS
+                 and not w.isdigit()]
+        # "a bottle of wine" -> "bottle" (the head comes before "of"), unless "of" is in a name.
+        if "of" in words:
+            k = words.index("of")
+            if " ".join(words) not in self.lexicon.phrases and k > 0:
+                words = words[:k]
+        if not words:
+            return None
+        text = " ".join(words)
+        # Rooms ("the kitchen", "the master bedroom").
+        for n in range(min(3, len(words)), 0, -1):
+            tail = " ".join(words[-n:])
+            if tail in ROOMS and not any(w not in ATTRIBUTE_WORDS for w in words[:-n]):
+                return NounPhrase(ROOMS[tail], tuple(words[:-n]), text, False, room=ROOMS[tail])
+        attrs = [w for w in words if w in ATTRIBUTE_WORDS]
+        rest = [w for w in words if w not in ATTRIBUTE_WORDS]
+        if not rest:  # "the white one", or a noun that is also an attribute word ("light")
+            hit = self.lexicon.lookup(words[-1])
+            if hit is None:
+                return None
+            return NounPhrase(hit, tuple(attrs[:-1]), text, True)
+        # Longest lexicon match ending at the last word, then anywhere.
+        for n in range(min(self.lexicon.max_words, len(rest)), 0, -1):
+            hit = self.lexicon.lookup(" ".join(rest[-n:]))
+            if hit is not None:
+                modifiers = [w for w in rest[:-n] if w not in ROOMS]
+                return NounPhrase(hit, tuple(attrs + modifiers), text, True)
+        # Attribute words that also name objects ("light") were removed; try the whole text.
+        hit = self.lexicon.lookup(text)
+        if hit is not None:
+            return NounPhrase(hit, (), text, True)
+        label, known = self.canonical(" ".join(rest))
+        if not known and len(rest) > 1:
+            label2, known2 = self.canonical(rest[-1])
+            if known2:
+                return NounPhrase(label2, tuple(attrs + rest[:-1]), text, True)
+        return NounPhrase(label, tuple(attrs), text, known)
+
+    def _most_similar(self, phrase: str) -> tuple[str | None, float]:
+        if self.similarity is None:
+            return None, 0.0
+        if phrase in self._sim_cache:
+            return self._sim_cache[phrase]
+        best, best_s = None, -1.0
+        for label in self.vocabulary:
+            s = float(self.similarity(phrase, _spaced(label)))
+            if s > best_s:
+                best, best_s = label, s
+        self._sim_cache[phrase] = (best, best_s)
+        return best, best_s
+
+    def _priors(self, label: str) -> tuple[str, ...]:
+        vocab = set(self.vocabulary)
+        priors = COOCCURRENCE.get(label)
+        if priors is None:
+            # Map synonyms of the vocabulary back to the prior table's names.
+            for candidates in _SYNONYMS.values():
+                if label in candidates and candidates[0] in COOCCURRENCE:
+                    priors = COOCCURRENCE[candidates[0]]
+                    break
+        if priors is None and self.similarity is not None:
+            best, score = None, -1.0
+            for key in COOCCURRENCE:
+                s = float(self.similarity(_spaced(label), _spaced(key)))
+                if s > score:
+                    best, score = key, s
+            if best is not None and score >= self.threshold:
+                priors = COOCCURRENCE[best]
+        out = []
+        for p in priors or ():
+            mapped = p if p in vocab else self.lexicon.lookup(_spaced(p))
+            if mapped is not None and mapped != label:
+                out.append(mapped)
+        return tuple(dict.fromkeys(out))
+
+
+# ---------------------------------------------------------------------------- entry points
+def default_similarity() -> Similarity | None:
+    """The MiniLM embedder's similarity (lazy), or None when perception is unavailable."""
+    try:
+        from hiconav.perception import get_embedder
+    except ImportError:  # pragma: no cover - perception is part of the package
+        return None
+    state: dict[str, Similarity] = {}
+
+    def similarity(a: str, b: str) -> float:
+        if "f" not in state:
+            state["f"] = get_embedder("minilm").similarity
+        return state["f"](a, b)
+
+    return similarity
+
+
+def parse_offline(instruction: str, config: ReasoningConfig | None = None, *,
+                  similarity: Similarity | None = None, vocabulary: Sequence[str] | None = None) -> TaskSpec:
+    """Offline decomposition (source="offline"). ``similarity`` None = MiniLM, loaded lazily."""
+    config = config or ReasoningConfig()
+    if similarity is None:
+        similarity = default_similarity()
+    parser = OfflineParser(vocabulary or config.vocabulary, similarity,
+                           threshold=config.label_similarity_threshold, max_related=config.max_related)
+    return parser.parse(instruction)
+
+
+def parse_vlm(instruction: str, config: ReasoningConfig, client, *,
+              similarity: Similarity | None = None, vocabulary: Sequence[str] | None = None) -> TaskSpec:
+    """VLM decomposition (source="vlm"); raises InstructionError with the reason on failure."""
+    from hiconav.reasoning.prompts import decomposition_messages
+    from hiconav.reasoning.replies import ReplyError, parse_decomposition
+
+    parser = OfflineParser(vocabulary or config.vocabulary, similarity,
+                           threshold=config.label_similarity_threshold, max_related=config.max_related)
+    messages = decomposition_messages(instruction, parser.vocabulary)
+    result = client.chat(messages)
+    if not result.ok:
+        raise InstructionError(f"VLM decomposition failed: {result.error} ({result.detail[:200]})",
+                               field="reasoning.vlm")
+    try:
+        reply = parse_decomposition(result.content, finish_reason=result.finish_reason,
+                                    message=result.message)
+    except ReplyError as exc:
+        raise InstructionError(f"VLM decomposition rejected: {exc.reason}: {exc.detail}",
+                               field="reasoning.vlm") from exc
+
+    def canon(label: str) -> str:
+        return parser.canonical(label)[0]
+
+    targets = tuple(dict.fromkeys(canon(t) for t in reply.targets))
+    related = tuple(r for r in dict.fromkeys(canon(r) for r in reply.related) if r not in targets)
+    attributes = {canon(k): v for k, v in reply.attributes.items()}
+    relations = tuple((canon(s), r, o if o in ROOMS.values() else canon(o)) for s, r, o in reply.relations)
+    return TaskSpec(instruction=instruction.strip(), targets=targets,
+                    related=related[:max(config.max_related, 1)], attributes=attributes,
+                    relations=relations, source="vlm")
+
+
+def decompose_instruction(instruction: str, config: ReasoningConfig | None = None, *,
+                          similarity: Similarity | None = None, client=None,
+                          vocabulary: Sequence[str] | None = None) -> TaskSpec:
+    """instruction -> TaskSpec: the VLM when an endpoint is configured, else the offline parser.
+
+    A VLM failure falls back to the offline parser (logged; the TaskSpec then says
+    source="offline") unless ``config.fallback_to_offline`` is False, which raises
+    InstructionError. ``client`` overrides the VLMClient built from ``config.vlm``.
+    """
+    config = config or ReasoningConfig()
+    if not isinstance(instruction, str) or not instruction.strip():
+        raise InstructionError("the instruction is empty", field="instruction")
+    if config.use_vlm() or client is not None:
+        own_client = client is None
+        if own_client:
+            from hiconav.reasoning.vlm_client import VLMClient
+
+            client = VLMClient(config.vlm)
+        try:
+            return parse_vlm(instruction, config, client, similarity=similarity, vocabulary=vocabulary)
+        except InstructionError as exc:
+            if not config.fallback_to_offline:
+                raise
+            log.warning("FALLBACK to the offline parser: %s", exc)
+        finally:
+            if own_client:
+                client.close()
+    return parse_offline(instruction, config, similarity=similarity, vocabulary=vocabulary)

@@ -1,0 +1,205 @@
+"""Instruction decomposition: the offline parser on the paper's kinds of instruction, the VLM
+backend over real HTTP, and the choice between them.
+
+Kinds (paper, "Experiments"): ObjectNav categories ("find a chair"), open-vocabulary
+descriptions ("the blue mug beside the sink") and TextNav-style descriptions with relations and
+several sentences.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from hiconav.reasoning import InstructionError, OfflineParser, ReasoningConfig, decompose_instruction
+from hiconav.reasoning.decompose import DEFAULT_VOCABULARY, OBJECTNAV_CATEGORIES
+
+from .fake_server import load_manifest
+from .helpers import fast_config
+
+
+def no_similarity(a: str, b: str) -> float:
+    return 0.0
+
+
+# instruction -> (targets, related that must be present, attributes, relations that must be present)
+CASES: list[tuple[str, tuple, tuple, dict, tuple]] = [
+    # ObjectNav categories, plain and with synonyms
+    ("Find a chair.", ("chair",), ("dining_table",), {}, ()),
+    ("go to the couch", ("sofa",), ("tv", "coffee_table"), {}, ()),
+    ("Navigate to the potted plant", ("plant",), (), {}, ()),
+    ("look for a bed", ("bed",), ("side_table",), {}, ()),
+    ("Please find the toilet", ("toilet",), ("sink", "bathtub"), {}, ()),
+    ("navigate to the television", ("tv",), ("sofa",), {}, ()),
+    ("Can you find me a TV?", ("tv",), ("sofa",), {}, ()),
+    ("find chairs", ("chair",), (), {}, ()),
+    ("Locate the refrigerator", ("fridge",), ("counter_top",), {}, ()),
+    ("find the bed or the sofa", ("bed", "sofa"), (), {}, ()),
+    # open-vocabulary descriptions
+    ("find the blue mug beside the sink", ("mug",), ("sink",), {"mug": ("blue",)},
+     (("mug", "next to", "sink"),)),
+    ("Look for the small wooden chair between the sofa and the TV", ("chair",), ("sofa", "tv"),
+     {"chair": ("small", "wooden")}, (("chair", "between", "sofa"), ("chair", "between", "tv"))),
+    ("Find the red book on top of the shelf", ("book",), ("shelving_unit",), {"book": ("red",)},
+     (("book", "on", "shelving_unit"),)),
+    ("Where is the lamp behind the armchair?", ("floor_lamp",), ("armchair",), {},
+     (("floor_lamp", "behind", "armchair"),)),
+    ("Go find the trash can under the sink", ("garbage_can",), ("sink",), {},
+     (("garbage_can", "under", "sink"),)),
+    ("I'm looking for a bottle of wine on the kitchen counter", ("wine_bottle",), ("counter_top",), {},
+     (("wine_bottle", "on", "counter_top"),)),
+    ("navigate to the black leather armchair in front of the fireplace", ("armchair",), ("fireplace",),
+     {"armchair": ("black", "leather")}, (("armchair", "in front of", "fireplace"),)),
+    ("find the chest of drawers", ("dresser",), ("bed",), {}, ()),
+    ("find the laptop on the desk next to the window", ("laptop",), ("desk", "window"), {},
+     (("laptop", "on", "desk"), ("desk", "next to", "window"))),
+    ("Go to the kitchen and find the fridge", ("fridge",), ("sink",), {}, (("fridge", "in", "kitchen"),)),
+    ("find a white towel to the left of the bathtub", ("towel",), ("bathtub",), {"towel": ("white",)},
+     (("towel", "left of", "bathtub"),)),
+    ("find the big green plant near the window in the living room", ("plant",), ("window",),
+     {"plant": ("big", "green")}, (("plant", "near", "window"), ("plant", "in", "living_room"))),
+    # TextNav-style descriptions: several sentences, "it" refers to the target
+    ("Find a chair. It is next to a white table in the dining room.", ("chair",), ("dining_table",),
+     {"dining_table": ("white",)}, (("chair", "next to", "dining_table"), ("chair", "in", "dining_room"))),
+    ("The target is a green plant near the window. It is on a small round table.", ("plant",),
+     ("window", "dining_table"), {"plant": ("green",)},
+     (("plant", "near", "window"), ("plant", "on", "dining_table"))),
+    ("Go to the pillow that is on the bed in the bedroom. It is white and soft.", ("pillow",), ("bed",),
+     {"pillow": ("white", "soft")}, (("pillow", "on", "bed"), ("pillow", "in", "bedroom"))),
+    ("A brown leather sofa, facing the television, with a coffee table in front of it.", ("sofa",),
+     ("tv", "coffee_table"), {"sofa": ("brown", "leather")},
+     (("sofa", "facing", "tv"), ("coffee_table", "in front of", "sofa"))),
+    ("Find the microwave. It sits above the stove, to the right of the fridge.", ("microwave",),
+     ("stove", "fridge"), {}, (("microwave", "above", "stove"), ("microwave", "right of", "fridge"))),
+    ("Find the cup. There is a plate next to it.", ("cup",), ("plate",), {}, (("plate", "next to", "cup"),)),
+]
+
+
+@pytest.fixture(scope="module")
+def parser() -> OfflineParser:
+    return OfflineParser(DEFAULT_VOCABULARY, no_similarity)
+
+
+@pytest.mark.parametrize("instruction,targets,related,attributes,relations", CASES,
+                         ids=[c[0][:40] for c in CASES])
+def test_offline_decomposition(parser, instruction, targets, related, attributes, relations) -> None:
+    task = parser.parse(instruction)
+    assert task.targets == targets
+    assert task.source == "offline"
+    for r in related:
+        assert r in task.related, (r, task.related)
+    assert not set(task.targets) & set(task.related)
+    for label, attrs in attributes.items():
+        assert set(attrs) <= set(task.attributes.get(label, ())), task.attributes
+    for rel in relations:
+        assert rel in task.relations, task.relations
+
+
+def test_pronouns_are_never_object_labels(parser) -> None:
+    for text in ("A sofa with a coffee table in front of it.", "Find the oven. It is under the microwave.",
+                 "find the cup. there is a plate next to it"):
+        task = parser.parse(text)
+        assert not {"it", "this", "that", "one"} & set(task.targets + task.related)
+        assert all("it" not in rel for rel in task.relations)
+
+
+def test_there_are_at_least_20_instructions_of_the_paper_kinds() -> None:
+    assert len(CASES) >= 20
+
+
+def test_every_objectnav_category_is_in_the_default_vocabulary(parser) -> None:
+    for cat in OBJECTNAV_CATEGORIES:
+        assert parser.parse(f"find the {cat.replace('_', ' ')}").targets == (cat,)
+
+
+def test_synonyms_follow_the_active_vocabulary() -> None:
+    p = OfflineParser(("refrigerator", "couch", "potted_plant", "television"), no_similarity)
+    assert p.parse("find the fridge").targets == ("refrigerator",)
+    assert p.parse("find the sofa").targets == ("couch",)
+    assert p.parse("find the plant").targets == ("potted_plant",)
+    assert p.parse("find the tv").targets == ("television",)
+
+
+def test_unknown_nouns_map_by_embedding_similarity() -> None:
+    table = {("divan", "sofa"): 0.81, ("divan", "bed"): 0.55}
+
+    def similarity(a: str, b: str) -> float:
+        return table.get((a, b), 0.1)
+
+    p = OfflineParser(DEFAULT_VOCABULARY, similarity, threshold=0.62)
+    assert p.parse("find the divan").targets == ("sofa",)
+    assert p.parse("find the fireplace").targets == ("fireplace",)  # open vocabulary, kept as said
+
+
+def test_related_objects_are_bounded_and_explicit_ones_come_first(parser) -> None:
+    task = parser.parse("find the mug next to the kettle")
+    assert task.related[0] == "kettle"
+    assert len(task.related) <= ReasoningConfig().max_related
+
+
+@pytest.mark.parametrize("bad", ["", "   ", "please", "find the", "go to the white one"])
+def test_instructions_without_an_object_are_errors(parser, bad: str) -> None:
+    with pytest.raises(InstructionError) as info:
+        parser.parse(bad)
+    assert info.value.field == "instruction"
+
+
+def test_without_an_endpoint_the_offline_parser_answers() -> None:
+    config = ReasoningConfig()
+    assert not config.use_vlm()
+    task = decompose_instruction("find the blue mug beside the sink", config, similarity=no_similarity)
+    assert task.source == "offline" and task.targets == ("mug",)
+
+
+# ---------------------------------------------------------------------------- VLM backend
+DECOMP = load_manifest()["decomposition"]
+
+
+@pytest.mark.parametrize("case", DECOMP, ids=[c["name"] for c in DECOMP])
+def test_vlm_decomposition_replies(server, case) -> None:
+    config = fast_config(server.base_url).model_copy(update={"fallback_to_offline": False})
+    server.script(case["file"])
+    expect = case["expect"]
+    if expect["ok"]:
+        task = decompose_instruction("find the blue mug beside the sink", config, similarity=no_similarity)
+        assert task.source == "vlm"
+        assert list(task.targets) == expect["targets"]
+        assert list(task.related) == expect["related"]
+    else:
+        with pytest.raises(InstructionError, match=expect["reason"]):
+            decompose_instruction("find the blue mug beside the sink", config, similarity=no_similarity)
+    body = server.requests[0]["json"]
+    assert body["response_format"] == {"type": "json_object"}
+    assert "find the blue mug beside the sink" in body["messages"][1]["content"]
+
+
+def test_vlm_failure_falls_back_to_the_offline_parser(server) -> None:
+    config = fast_config(server.base_url)
+    server.script(*[{"file": "http_500.json", "status": 500}] * 2)
+    task = decompose_instruction("find the blue mug beside the sink", config, similarity=no_similarity)
+    assert task.source == "offline" and task.targets == ("mug",)
+    assert len(server.requests) == 2
+
+
+def test_an_invalid_vlm_decomposition_falls_back_too(server) -> None:
+    server.script("decomp_injection.json")
+    task = decompose_instruction("go to the couch", fast_config(server.base_url), similarity=no_similarity)
+    assert task.source == "offline" and task.targets == ("sofa",)
+
+
+def test_backend_offline_ignores_the_endpoint(server) -> None:
+    config = fast_config(server.base_url).model_copy(update={"backend": "offline"})
+    server.script("decomp_good.json")
+    task = decompose_instruction("go to the couch", config, similarity=no_similarity)
+    assert task.source == "offline" and server.requests == []
+
+
+@pytest.mark.slow
+def test_minilm_maps_unknown_nouns_and_keeps_unrelated_ones() -> None:
+    """With the real embedder (loads all-MiniLM-L6-v2 from the pip package: slow on 2 cores)."""
+    from hiconav.reasoning.decompose import default_similarity
+
+    threshold = ReasoningConfig().label_similarity_threshold
+    p = OfflineParser(DEFAULT_VOCABULARY, default_similarity(), threshold=threshold)
+    assert p.parse("find the refrigerator unit").targets == ("fridge",)  # similarity ~0.78
+    assert p.parse("find the teapot").targets == ("kettle",)  # ~0.63
+    assert p.parse("go to the fireplace").targets == ("fireplace",)  # nearest is stove at ~0.59: kept
