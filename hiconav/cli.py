@@ -30,6 +30,7 @@ SUBCOMMANDS: list[tuple[str, str, str]] = [
     ("sim", "hiconav.sim.cli", "sim"),
     ("vehicle", "hiconav.drivers.cli", "vehicle"),
     ("parse", "hiconav.reasoning.cli", "parse"),
+    ("eval", "hiconav.eval.cli", "eval"),
 ]
 
 

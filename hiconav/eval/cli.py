@@ -1,0 +1,120 @@
+"""``hiconav eval``: run a benchmark (episodes x presets) and write episodes.jsonl, summary.json,
+report.md and plots into ``--out``. Registered in ``hiconav/cli.py`` as ("eval",
+"hiconav.eval.cli", "eval").
+
+Heavy imports (simulator, matplotlib, Ray) happen inside the command. This module must not hold
+benchmark logic beyond turning options into a source and an ``EvalConfig``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shlex
+import sys
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from hiconav.errors import ConfigError, DataError
+
+
+def _parse_sets(items: list[str]) -> dict[str, Any]:
+    import yaml
+
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ConfigError(f"--set expects KEY=VALUE (dotted key), got {item!r}", field="--set")
+        out[key.strip()] = yaml.safe_load(value)
+    return out
+
+
+SOURCE_FILE = "source.json"
+SPECS_FILE = "specs.jsonl"
+
+
+def _cached_specs(out: Path, source: dict[str, Any]) -> list[Any] | None:
+    """The episode specs saved by an earlier run into ``out`` from the same source options (so a
+    resumed run does not generate episodes again), or None."""
+    from hiconav.eval.sources import read_specs
+
+    try:
+        saved = json.loads((out / SOURCE_FILE).read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError):
+        return None
+    if saved != source or not (out / SPECS_FILE).exists():
+        return None
+    return read_specs(out / SPECS_FILE)
+
+
+def _save_specs(out: Path, source: dict[str, Any], specs: list[Any]) -> None:
+    from hiconav.eval.sources import write_specs
+
+    out.mkdir(parents=True, exist_ok=True)
+    write_specs(out / SPECS_FILE, specs)
+    (out / SOURCE_FILE).write_text(json.dumps(source, indent=2) + "\n", encoding="utf-8")
+
+
+def eval(
+    out: Path = typer.Option(..., "--out", help="Output folder (episodes.jsonl, summary.json, report.md, plots)."),
+    houses: Path | None = typer.Option(None, "--houses", help="ProcTHOR houses FILE.jsonl.gz (episodes are generated)."),
+    episodes_per_house: int = typer.Option(3, "--episodes-per-house", min=1, help="Generated episodes per house/floor."),
+    maps: Path | None = typer.Option(None, "--maps", help="Gibson semantic maps FILE.pbz2."),
+    episodes: list[Path] | None = typer.Option(None, "--episodes", help="Habitat ObjectNav episode files or folders (with --maps; without: generated)."),
+    seed: int = typer.Option(0, "--seed", help="Base seed (episode generation and per-episode seeds)."),
+    limit: int | None = typer.Option(None, "--limit", min=1, help="Run only the first N episodes."),
+    workers: int | None = typer.Option(None, "--workers", min=0, help="Worker processes (default: core count; 0 = in this process)."),
+    preset: str = typer.Option("full", "--preset", help="Preset name(s), comma separated, or 'ablations' for all."),
+    backend: str = typer.Option("local", "--backend", help="local (worker processes) or ray."),
+    address: str | None = typer.Option(None, "--address", help="Ray cluster address (ray backend)."),
+    runner: str = typer.Option("hiconav.mission:run_episode", "--runner", help="Episode runner import path module:function."),
+    set_: list[str] | None = typer.Option(None, "--set", help="Extra settings override KEY=VALUE (dotted key), repeatable."),
+    stuck_window: int = typer.Option(50, "--stuck-window", min=1, help="Steps without progress that count as stuck."),
+    progress: bool = typer.Option(True, "--progress/--no-progress", help="Show the progress bar."),
+) -> None:
+    """Run ObjectNav episodes in parallel and write metrics, the failure taxonomy and a report."""
+    from hiconav.eval.config import EvalConfig
+    from hiconav.eval.presets import resolve_presets
+    from hiconav.eval.runner import evaluate
+    from hiconav.eval.sources import gibson_source, procthor_source
+
+    if (houses is None) == (maps is None):
+        raise ConfigError("give exactly one input: --houses FILE.jsonl.gz or --maps FILE.pbz2", field="--houses/--maps")
+    if episodes and maps is None:
+        raise ConfigError("--episodes (Habitat episode files) goes with --maps", field="--episodes")
+    if backend not in ("local", "ray"):
+        raise ConfigError(f"unknown backend {backend!r}; known: local, ray", field="--backend")
+    if address and backend != "ray":
+        raise ConfigError("--address is for --backend ray", field="--address")
+    for path, option in ((houses, "--houses"), (maps, "--maps"), *((p, "--episodes") for p in episodes or [])):
+        if path is not None and not Path(path).exists():
+            raise DataError(f"file not found: {path}", file=str(path), field=option)
+    presets = resolve_presets(preset)  # fail on a bad preset before building episodes
+    config = EvalConfig(runner=runner, presets=tuple(presets), overrides=_parse_sets(set_ or []), seed=seed,
+                        workers=workers, backend=backend, address=address, stuck_window=stuck_window,
+                        progress=progress)
+    n_workers = workers if workers is not None else (os.cpu_count() or 1)
+    source = {"houses": str(Path(houses).resolve()) if houses else None,
+              "maps": str(Path(maps).resolve()) if maps else None,
+              "episodes": [str(Path(p).resolve()) for p in episodes or []],
+              "episodes_per_house": episodes_per_house, "seed": seed, "limit": limit}
+    specs = _cached_specs(Path(out), source)
+    if specs is None:
+        if houses is not None:
+            specs = procthor_source(houses, episodes_per_house, seed=seed, limit=limit, workers=n_workers)
+        else:
+            specs = gibson_source(maps, episodes, episodes_per_house=episodes_per_house, seed=seed, limit=limit,
+                                  workers=n_workers)
+        _save_specs(Path(out), source, specs)
+    if not specs:
+        raise DataError("the input holds no episode", field="--houses/--maps")
+    command = "hiconav eval " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if len(sys.argv) > 2 else ""
+    summary = evaluate(specs, out, config, run_info={"command": command,
+                                                     "source": str(houses or maps), "episodes": len(specs)})
+    sr, spl = summary.get("success_rate"), summary.get("spl")
+    typer.echo(f"{summary['episodes']} episodes ({summary['preset']}): "
+               f"SR {sr if sr is None else round(sr, 3)}  SPL {spl if spl is None else round(spl, 3)}  "
+               f"-> {Path(out) / 'report.md'}")

@@ -1,0 +1,225 @@
+"""report.md and PNG plots of a benchmark run, laid out like the paper's tables.
+
+Sections: main results per preset (SR, SPL, DTS), ablations (paired deltas against the full
+method, with sign and size), failure taxonomy, efficiency (seconds per frame of each layer,
+task time in stepped time, step speed, VLM calls), success by target category; plots: success by
+target category, SPL histogram, failure breakdown, per-layer latency, linked from report.md.
+Wherever the oracle detector or the offline reasoner was used, the report says so.
+
+Plots use matplotlib's Agg canvas directly (no pyplot, no global backend change, no display).
+This module must not run episodes or change records.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from hiconav.eval.presets import DESCRIPTIONS
+from hiconav.eval.records import EpisodeRecord
+from hiconav.eval.taxonomy import CATEGORIES
+
+PLOTS = {
+    "success_by_target": "success_by_target.png",
+    "spl_hist": "spl_hist.png",
+    "failures": "failures.png",
+    "layer_latency": "layer_latency.png",
+}
+
+
+def _pct(value: float | None) -> str:
+    return "-" if value is None else f"{100.0 * value:.1f}"
+
+
+def _num(value: float | None, digits: int = 2) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
+
+
+def _signed(value: float | None) -> str:
+    return "-" if value is None else f"{100.0 * value:+.1f}"
+
+
+def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return lines + [""]
+
+
+def component_labels(names: Sequence[str], kind: str) -> str:
+    """'oracle detector' / 'offline reasoner' labels, spelled out wherever they were used."""
+    if not names:
+        return f"(no {kind} named)"
+    return ", ".join(f"{name} {kind}" for name in names)
+
+
+def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
+                    run_info: dict[str, Any] | None = None, plots: dict[str, str] | None = None) -> str:
+    presets: dict[str, dict[str, Any]] = summary.get("presets", {})
+    main = summary.get("preset")
+    lines = ["# hiconav evaluation report", ""]
+    detectors = sorted({d for p in presets.values() for d in p["detectors"]})
+    reasoners = sorted({r for p in presets.values() for r in p["reasoners"]})
+    lines += [f"- Perception: {component_labels(detectors, 'detector')}",
+              f"- Reasoning: {component_labels(reasoners, 'reasoner')}"]
+    if "oracle" in detectors:
+        lines.append("- Results use the **oracle detector** (simulator instance ids with noise), "
+                     "not a learned detector.")
+    if "offline" in reasoners:
+        lines.append("- Results use the **offline reasoner** (no VLM was called).")
+    for key, value in (run_info or {}).items():
+        if value not in (None, ""):
+            lines.append(f"- {key}: `{value}`")
+    lines += ["", "## Main results", ""]
+    rows = []
+    for name, group in presets.items():
+        rows.append([name, DESCRIPTIONS.get(name, name), str(group["episodes"]), str(group["valid_episodes"]),
+                     _pct(group["success_rate"]), _pct(group["spl"]), _num(group["dts"]),
+                     ", ".join(group["detectors"]) or "-", ", ".join(group["reasoners"]) or "-"])
+    lines += _table(["Preset", "Method", "Episodes", "Valid", "SR (%)", "SPL (%)", "DTS (m)",
+                     "Detector", "Reasoner"], rows)
+    lines += [("SR and SPL over valid episodes (invalid input is counted but not run); DTS is the mean "
+               "geodesic distance to the success region at the end."), ""]
+
+    ablations: dict[str, dict[str, Any]] = summary.get("ablations", {})
+    lines += ["## Ablations", ""]
+    if ablations:
+        rows = [[DESCRIPTIONS.get(main, str(main)) + " (reference)", "-",
+                 _pct(next(iter(ablations.values()))["reference_success_rate"]),
+                 _pct(next(iter(ablations.values()))["reference_spl"]), "", ""]]
+        for name, delta in ablations.items():
+            rows.append([DESCRIPTIONS.get(name, name), str(delta["paired_episodes"]),
+                         _pct(delta["success_rate"]), _pct(delta["spl"]),
+                         _signed(delta["delta_success_rate"]), _signed(delta["delta_spl"])])
+        lines += _table(["Method", "Paired episodes", "SR (%)", "SPL (%)", "dSR (pts)", "dSPL (pts)"], rows)
+        lines += [f"Deltas are paired: each preset against `{main}` on the episodes both ran, same seeds.", ""]
+    else:
+        lines += ["Only one preset ran; run `--preset ablations` for this table.", ""]
+
+    lines += ["## Failure taxonomy", ""]
+    categories = list(CATEGORIES) + sorted({c for g in presets.values() for c in g["failures"]} - set(CATEGORIES))
+    rows = []
+    for category in categories:
+        row = [category]
+        for group in presets.values():
+            n = group["failures"].get(category, 0)
+            row.append(f"{n} ({_pct(n / group['episodes'] if group['episodes'] else None)}%)")
+        rows.append(row)
+    lines += _table(["Category", *presets], rows)
+    lines += [("Definitions: docs/evaluation.md (success, false positive, no frontier left, stuck, "
+               "step-out, invalid episode, error)."), ""]
+
+    lines += ["## Efficiency", ""]
+    layer_names = sorted({layer for g in presets.values() for layer in g["timing"]["layers"]})
+    rows = []
+    for name, group in presets.items():
+        timing = group["timing"]
+        row = [name, _num(timing["task_time_s_mean"], 1), _num(timing["step_speed_m_per_s"]),
+               _num(timing["steps_mean"], 0), _num(timing["vlm_calls_mean"], 1),
+               _num(timing["wall_time_s_mean"], 2)]
+        for layer in layer_names:
+            spf = timing["layers"].get(layer, {}).get("seconds_per_frame")
+            row.append("-" if spf is None else f"{spf * 1000.0:.3g}")
+        rows.append(row)
+    lines += _table(["Preset", "Task time (s, stepped)", "Step speed (m/s)", "Steps", "VLM calls",
+                     "Wall s / episode", *[f"{layer} (ms/frame)" for layer in layer_names]], rows)
+    lines += [("Layer times are wall-clock seconds per processed frame; task time is simulated "
+               "(stepped-clock) time. Wall times depend on the machine and its load."), ""]
+
+    if main is not None and presets.get(main, {}).get("by_target"):
+        lines += [f"## Success by target category ({main})", ""]
+        rows = [[t, str(v["episodes"]), _pct(v["success_rate"]), _pct(v["spl"])]
+                for t, v in presets[main]["by_target"].items()]
+        lines += _table(["Target", "Episodes", "SR (%)", "SPL (%)"], rows)
+
+    errors = [r for r in records if r.error]
+    if errors:
+        lines += ["## Episodes with errors or invalid input", ""]
+        rows = [[r.preset, r.episode_id, r.failure, (r.error or "").replace("|", "/")[:160]] for r in errors[:50]]
+        lines += _table(["Preset", "Episode", "Category", "Message"], rows)
+        if len(errors) > 50:
+            lines += [f"... and {len(errors) - 50} more (see episodes.jsonl).", ""]
+
+    if plots:
+        lines += ["## Plots", ""]
+        for title, file in plots.items():
+            lines += [f"![{title}]({file})", ""]
+    return "\n".join(lines)
+
+
+def write_plots(out: str | Path, records: Sequence[EpisodeRecord], summary: dict[str, Any]) -> dict[str, str]:
+    """The four PNG plots in ``out``; returns {title: file name} of those written."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    out = Path(out)
+    presets: dict[str, dict[str, Any]] = summary.get("presets", {})
+    main = summary.get("preset")
+    written: dict[str, str] = {}
+
+    def save(fig: Figure, key: str, title: str) -> None:
+        FigureCanvasAgg(fig)
+        fig.tight_layout()
+        fig.savefig(out / PLOTS[key], dpi=110)
+        written[title] = PLOTS[key]
+
+    if main is not None and main in presets:
+        by_target = presets[main]["by_target"]
+        fig = Figure(figsize=(max(4.0, 0.6 * len(by_target) + 2), 3.2))
+        ax = fig.add_subplot()
+        names = list(by_target)
+        ax.bar(names, [100.0 * (by_target[t]["success_rate"] or 0.0) for t in names], color="#4c72b0")
+        ax.set_ylabel("success rate (%)")
+        ax.set_ylim(0, 100)
+        ax.set_title(f"Success by target category ({main})")
+        ax.tick_params(axis="x", rotation=45)
+        save(fig, "success_by_target", "Success by target category")
+
+    fig = Figure(figsize=(5.0, 3.2))
+    ax = fig.add_subplot()
+    for name in presets:
+        values = [r.spl for r in records if r.preset == name and r.failure != "invalid_episode"]
+        if values:
+            ax.hist(values, bins=20, range=(0.0, 1.0), histtype="step", label=name, linewidth=1.5)
+    ax.set_xlabel("SPL")
+    ax.set_ylabel("episodes")
+    ax.set_title("SPL histogram")
+    if presets:
+        ax.legend(fontsize=7)
+    save(fig, "spl_hist", "SPL histogram")
+
+    fig = Figure(figsize=(max(5.0, 1.0 * len(presets) + 3), 3.4))
+    ax = fig.add_subplot()
+    names = list(presets)
+    bottoms = [0.0] * len(names)
+    for category in CATEGORIES:
+        heights = [100.0 * presets[p]["failure_rates"].get(category, 0.0) for p in names]
+        if any(heights):
+            ax.bar(names, heights, bottom=bottoms, label=category)
+            bottoms = [b + h for b, h in zip(bottoms, heights)]
+    ax.set_ylabel("episodes (%)")
+    ax.set_title("Outcome breakdown (failure taxonomy)")
+    ax.tick_params(axis="x", rotation=30)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.0, 0.5))
+    save(fig, "failures", "Failure breakdown")
+
+    layers = presets.get(main, {}).get("timing", {}).get("layers", {}) if main else {}
+    fig = Figure(figsize=(5.0, 3.2))
+    ax = fig.add_subplot()
+    names = [n for n, v in layers.items() if v["seconds_per_frame"] is not None]
+    ax.barh(names, [1000.0 * layers[n]["seconds_per_frame"] for n in names], color="#dd8452")
+    ax.set_xlabel("ms per frame (wall clock)")
+    ax.set_title(f"Per-layer latency ({main})")
+    save(fig, "layer_latency", "Per-layer latency")
+    return written
+
+
+def write_report(out: str | Path, records: Sequence[EpisodeRecord], summary: dict[str, Any],
+                 run_info: dict[str, Any] | None = None) -> Path:
+    """Write the plots and ``report.md`` into ``out``; returns the report's path."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    plots = write_plots(out, records, summary)
+    path = out / "report.md"
+    path.write_text(render_markdown(records, summary, run_info, plots), encoding="utf-8")
+    return path

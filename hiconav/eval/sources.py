@@ -1,0 +1,395 @@
+"""Episode sources for ``hiconav eval``: ProcTHOR houses with generated episodes, Gibson floors
+with Habitat ObjectNav episode files (or generated episodes), as small picklable ``EpisodeSpec``s.
+
+An ``EpisodeSpec`` carries the house spec string (``"procthor:val/3"``, ``"gibson:Allensville/0"``)
+and the episode's fields, never the house itself, so that it crosses process and Ray boundaries
+cheaply; each worker loads a house once and keeps it (``load_house_cached``).
+
+Bad input never aborts a run: a house that cannot be loaded becomes one spec with ``error`` set,
+which the harness records as an ``invalid_episode``. Missing input files are reported at once
+(``DataError`` naming the file and option).
+
+This module must not run episodes. The simulator (``hiconav.sim``) is imported lazily.
+"""
+
+from __future__ import annotations
+
+import bz2
+import functools
+import gzip
+import json
+import os
+import pickle
+import zlib
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from hiconav.errors import DataError, HiconavError
+
+
+@dataclass(frozen=True)
+class EpisodeSpec:
+    """One episode to run: the house spec string and the episode's fields (a few hundred bytes).
+
+    start: (x, y, yaw) world metres / radians. ``episode_id`` is unique within a source;
+    ``source_id`` is the simulator's own id of the episode. ``error`` marks bad input found
+    while building the source (the episode is recorded as invalid, not run).
+    """
+
+    episode_id: str
+    house: str
+    target: str
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    goal_instance_ids: tuple[int, ...] = ()
+    geodesic_distance: float = 0.0
+    instruction: str = ""
+    source_id: str = ""
+    error: str | None = None
+
+    @staticmethod
+    def from_episode(episode: Any, *, episode_id: str | None = None) -> EpisodeSpec:
+        """From a ``hiconav.sim.episodes.Episode``."""
+        start = episode.start
+        return EpisodeSpec(
+            episode_id=episode_id or str(episode.episode_id),
+            house=str(episode.house),
+            target=str(episode.target),
+            start=(float(start.x), float(start.y), float(start.yaw)),
+            goal_instance_ids=tuple(int(i) for i in episode.goal_instance_ids),
+            geodesic_distance=float(episode.geodesic_distance),
+            instruction=str(getattr(episode, "instruction", "") or ""),
+            source_id=str(episode.episode_id),
+        )
+
+    def to_episode(self) -> Any:
+        """The ``hiconav.sim.episodes.Episode`` of this spec (imports the simulator)."""
+        from hiconav.sim.episodes import Episode
+        from hiconav.types import Pose2D
+
+        return Episode(
+            episode_id=self.source_id or self.episode_id,
+            house=self.house,
+            start=Pose2D(*self.start),
+            target=self.target,
+            goal_instance_ids=tuple(self.goal_instance_ids),
+            geodesic_distance=self.geodesic_distance,
+            instruction=self.instruction,
+        )
+
+    def load_house(self) -> Any:
+        """The house of this episode, loaded once per process (see ``load_house_cached``)."""
+        return load_house_cached(self.house)
+
+    def to_json(self) -> dict[str, Any]:
+        return {"episode_id": self.episode_id, "house": self.house, "target": self.target,
+                "start": list(self.start), "goal_instance_ids": list(self.goal_instance_ids),
+                "geodesic_distance": self.geodesic_distance, "instruction": self.instruction,
+                "source_id": self.source_id, "error": self.error}
+
+    @staticmethod
+    def from_json(data: dict[str, Any]) -> EpisodeSpec:
+        return EpisodeSpec(episode_id=str(data["episode_id"]), house=str(data["house"]),
+                           target=str(data["target"]), start=tuple(float(v) for v in data["start"]),
+                           goal_instance_ids=tuple(int(i) for i in data.get("goal_instance_ids", ())),
+                           geodesic_distance=float(data.get("geodesic_distance", 0.0)),
+                           instruction=str(data.get("instruction", "")),
+                           source_id=str(data.get("source_id", "")), error=data.get("error"))
+
+
+@functools.lru_cache(maxsize=8)
+def load_house_cached(spec: str) -> Any:
+    """``hiconav.sim.load_house(spec)``, memoised per process (each worker loads a house once).
+
+    ``<file.jsonl.gz>#<index>`` (a house of a multi-house ProcTHOR file outside the data root):
+    if the simulator does not take that spec itself, the fallback extracts that line to a
+    one-house file in a per-process temporary folder and loads it by path."""
+    from hiconav.sim import load_house
+
+    path, sep, index = spec.rpartition("#")
+    if not sep or not index.isdigit() or not Path(path).is_file():
+        return load_house(spec)
+    try:
+        return load_house(spec)
+    except HiconavError:
+        pass
+    # Fallback (labelled): the simulator loads one-house files by path.
+    import tempfile
+
+    opener = gzip.open if path.endswith(".gz") else open
+    with opener(path, "rt", encoding="utf-8") as fh:
+        line = next((text for i, text in enumerate(fh) if i == int(index)), None)
+    if line is None:
+        raise DataError(f"no house at line {int(index) + 1}", file=path, field="house")
+    folder = Path(tempfile.gettempdir()) / f"hiconav-eval-houses-{os.getpid()}"
+    folder.mkdir(exist_ok=True)
+    single = folder / f"{Path(path).name.split('.')[0]}-{index}.json"
+    single.write_text(line, encoding="utf-8")
+    return load_house(str(single))
+
+
+def derive_seed(base_seed: int, name: str) -> int:
+    """A stable 31-bit seed for ``name`` under ``base_seed`` (same on every machine and run)."""
+    return zlib.crc32(f"{int(base_seed)}:{name}".encode()) & 0x7FFFFFFF
+
+
+def _require_file(path: str | Path, option: str) -> Path:
+    path = Path(path).expanduser()
+    if not path.exists():
+        raise DataError(f"file not found: {path}", file=str(path), field=option)
+    return path
+
+
+def _data_file(kind: str) -> Path | None:
+    """The resolved data root's folder for ``kind`` (procthor | gibson), or None."""
+    try:
+        from hiconav.data import data_root
+
+        return (data_root() / kind).resolve()
+    except HiconavError:
+        return None
+
+
+# ---------------------------------------------------------------------------------------- ProcTHOR
+
+
+def procthor_house_specs(houses_file: str | Path) -> list[str]:
+    """House spec strings of every house (line) in a ProcTHOR ``*.jsonl.gz`` file.
+
+    Files of the data root map to ``procthor:<split>/<index>``; a one-house file to its path;
+    any other file to ``<path>#<index>`` (a file path spec with the line index).
+    """
+    path = _require_file(houses_file, "--houses")
+    opener = gzip.open if path.suffix == ".gz" else open
+    try:
+        with opener(path, "rt", encoding="utf-8") as fh:
+            count = sum(1 for line in fh if line.strip())
+    except (OSError, EOFError, UnicodeDecodeError) as exc:
+        raise DataError(f"cannot read houses file: {exc}", file=str(path), field="--houses") from exc
+    if count == 0:
+        raise DataError("houses file holds no house", file=str(path), field="--houses")
+    root = _data_file("procthor")
+    resolved = path.resolve()
+    if root is not None and resolved.parent == root and resolved.name.endswith(".jsonl.gz"):
+        split = resolved.name[: -len(".jsonl.gz")]
+        return [f"procthor:{split}/{i}" for i in range(count)]
+    if count == 1:
+        return [str(resolved)]  # a one-house file: the simulator loads it by path
+    return [f"{resolved}#{i}" for i in range(count)]
+
+
+def procthor_source(houses_file: str | Path, episodes_per_house: int, seed: int = 0,
+                    limit: int | None = None, *, workers: int = 1) -> list[EpisodeSpec]:
+    """Episodes generated on every house of ``houses_file`` (``hiconav.sim.generate_episodes``,
+    seeded per house from ``seed``), in house order, the first ``limit`` when given.
+
+    Generation takes up to a few seconds per house (geodesic fields), so with ``workers`` > 1
+    houses are generated in parallel worker processes; the result does not depend on it."""
+    if episodes_per_house < 1:
+        raise DataError("must be at least 1", field="--episodes-per-house")
+    specs = procthor_house_specs(houses_file)
+    return _take(_generated(specs, episodes_per_house, seed, limit, workers), limit)
+
+
+def generate_for_house(house_spec: str, n: int, seed: int) -> list[EpisodeSpec]:
+    """``n`` generated episodes of one house as specs; a house that fails gives one invalid spec."""
+    try:
+        from hiconav.sim import generate_episodes
+
+        house = load_house_cached(house_spec)
+        episodes = generate_episodes(house, n, seed=derive_seed(seed, house_spec))
+    except ImportError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - bad input: recorded as an invalid episode, never aborts
+        return [EpisodeSpec(episode_id=f"{house_spec}/invalid", house=house_spec, target="",
+                            error=f"cannot load house or generate episodes: {type(exc).__name__}: {exc}")]
+    # the house field is the spec we loaded it by (workers reload it by that string)
+    return [replace(EpisodeSpec.from_episode(episode, episode_id=f"{house_spec}/{index}"), house=house_spec)
+            for index, episode in enumerate(episodes)]
+
+
+def _generated(house_specs: Sequence[str], n: int, seed: int, limit: int | None = None,
+               workers: int = 1) -> Iterator[EpisodeSpec]:
+    """Specs of the houses in order, generating only as many houses as ``limit`` needs."""
+    needed = len(house_specs) if limit is None else min(len(house_specs), -(-limit // n))
+    if workers <= 1 or needed <= 1:
+        for house_spec in house_specs:
+            yield from generate_for_house(house_spec, n, seed)
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    context = multiprocessing.get_context("forkserver" if "forkserver" in multiprocessing.get_all_start_methods()
+                                          else "spawn")
+    count = 0
+    position = 0
+    with ProcessPoolExecutor(max_workers=min(workers, needed), mp_context=context) as pool:
+        while position < len(house_specs) and (limit is None or count < limit):
+            batch = house_specs[position: position + max(needed - position, 2 * workers)]
+            position += len(batch)
+            for specs in pool.map(generate_for_house, batch, [n] * len(batch), [seed] * len(batch)):
+                count += len(specs)
+                yield from specs
+
+
+def _take(specs: Iterable[EpisodeSpec], limit: int | None) -> list[EpisodeSpec]:
+    out: list[EpisodeSpec] = []
+    seen: set[str] = set()
+    for spec in specs:
+        if limit is not None and len(out) >= limit:
+            break
+        if spec.episode_id in seen:  # keep keys unique for resume
+            spec = replace(spec, episode_id=f"{spec.episode_id}#{len(out)}")
+        seen.add(spec.episode_id)
+        out.append(spec)
+    return out
+
+
+# ------------------------------------------------------------------------------------------ Gibson
+
+
+def gibson_house_specs(maps_file: str | Path) -> list[str]:
+    """House spec strings of every (scene, floor) in a Gibson semantic-map ``*.pbz2`` file.
+
+    The data root's file maps to ``gibson:<Scene>/<floor>``; any other to ``<path>#<Scene>/<floor>``.
+    """
+    path = _require_file(maps_file, "--maps").resolve()
+    return list(_gibson_house_specs(path, path.stat().st_mtime_ns))
+
+
+@functools.lru_cache(maxsize=4)
+def _gibson_house_specs(path: Path, _mtime_ns: int) -> tuple[str, ...]:
+    try:
+        with bz2.open(path, "rb") as fh:
+            maps = pickle.load(fh)
+    except (OSError, EOFError, pickle.UnpicklingError, ValueError) as exc:
+        raise DataError(f"cannot read Gibson maps (bz2 pickle): {exc}", file=str(path), field="--maps") from exc
+    if not isinstance(maps, dict) or not maps:
+        raise DataError("expected {scene: {floor: {...}}}", file=str(path), field="--maps")
+    root = _data_file("gibson")
+    prefix = "gibson:" if root is not None and path.resolve().parent == root else f"{path.resolve()}#"
+    return tuple(f"{prefix}{scene}/{floor}" for scene in sorted(maps) for floor in sorted(maps[scene]))
+
+
+def habitat_episode_files(paths: Sequence[str | Path]) -> list[Path]:
+    """Expand folders to their ``*.json.gz`` / ``*.json`` files (sorted); check files exist."""
+    files: list[Path] = []
+    for item in paths:
+        path = _require_file(item, "--episodes")
+        if path.is_dir():
+            found = sorted({*path.rglob("*.json.gz"), *path.rglob("*.json")})
+            if not found:
+                raise DataError("folder holds no *.json.gz or *.json episode file", file=str(path),
+                                field="--episodes")
+            files += found
+        else:
+            files.append(path)
+    return files
+
+
+def _habitat_groups(path: Path) -> dict[tuple[str, int], list[dict[str, Any]]]:
+    """(scene, floor) -> the raw episodes of one Habitat ObjectNav episode file."""
+    opener = gzip.open if path.suffix == ".gz" else open
+    try:
+        with opener(path, "rt", encoding="utf-8") as fh:
+            data = json.load(fh)
+    except (OSError, EOFError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise DataError(f"cannot read Habitat episodes: {exc}", file=str(path), field="--episodes") from exc
+    episodes = data.get("episodes") if isinstance(data, dict) else None
+    if not isinstance(episodes, list):
+        raise DataError("expected an object with an 'episodes' list", file=str(path), field="episodes")
+    groups: dict[tuple[str, int], list[dict[str, Any]]] = {}
+    for i, episode in enumerate(episodes):
+        scene = Path(str(episode.get("scene_id", "") if isinstance(episode, dict) else "")).name.split(".")[0]
+        if not scene:
+            raise DataError("episode without scene_id", file=str(path), field=f"episodes[{i}].scene_id")
+        try:
+            floor = int(episode.get("floor_id", 0) or 0)
+        except (TypeError, ValueError) as exc:
+            raise DataError(f"bad floor_id: {exc}", file=str(path), field=f"episodes[{i}].floor_id") from exc
+        groups.setdefault((scene, floor), []).append({"_index": i, **episode})
+    return groups
+
+
+def gibson_source(maps_file: str | Path, episodes: Sequence[str | Path] | None = None, *,
+                  episodes_per_house: int = 3, seed: int = 0, limit: int | None = None,
+                  workers: int = 1) -> list[EpisodeSpec]:
+    """Gibson floors of ``maps_file`` with the Habitat episodes of ``episodes`` (files or folders,
+    ``hiconav.sim.load_habitat_episodes``), or, without episode files, generated episodes."""
+    house_specs = gibson_house_specs(maps_file)
+    if not episodes:
+        return _take(_generated(house_specs, episodes_per_house, seed, limit, workers), limit)
+    by_scene = {spec.rpartition("#")[2].removeprefix("gibson:"): spec for spec in house_specs}
+    return _take(_habitat(habitat_episode_files(episodes), by_scene), limit)
+
+
+def _habitat(files: list[Path], by_scene: dict[str, str]) -> Iterator[EpisodeSpec]:
+    for path in files:
+        for (scene, floor), raw in sorted(_habitat_groups(path).items()):
+            house_spec = by_scene.get(f"{scene}/{floor}")
+            stem = f"{path.name}:{scene}/{floor}"
+            if house_spec is None:
+                for episode in raw:
+                    yield EpisodeSpec(episode_id=f"{stem}/{episode.get('episode_id', episode['_index'])}",
+                                      house=f"gibson:{scene}/{floor}", target=str(episode.get("object_category", "")),
+                                      error=f"{path}: scene {scene} floor {floor} is not in the maps file")
+                continue
+            yield from _habitat_group(path, raw, house_spec, stem)
+
+
+def _habitat_group(path: Path, raw: list[dict[str, Any]], house_spec: str, stem: str) -> Iterator[EpisodeSpec]:
+    """One (scene, floor) of a file through ``hiconav.sim.load_habitat_episodes``; when the file
+    fails as a whole, episode by episode, so that one bad episode is one invalid record."""
+    import tempfile
+
+    from hiconav.sim import load_habitat_episodes
+
+    try:
+        house = load_house_cached(house_spec)
+    except Exception as exc:  # noqa: BLE001 - bad input: recorded, never aborts
+        for episode in raw:
+            yield EpisodeSpec(episode_id=f"{stem}/{episode.get('episode_id', episode['_index'])}", house=house_spec,
+                              target=str(episode.get("object_category", "")), error=f"cannot load house: {exc}")
+        return
+    try:
+        loaded = [load_habitat_episodes(path, house)]
+    except Exception:  # noqa: BLE001 - retried per episode below to find the bad ones
+        loaded = []
+        with tempfile.TemporaryDirectory() as tmp:
+            for episode in raw:
+                single = Path(tmp) / "episode.json"
+                single.write_text(json.dumps({"episodes": [{k: v for k, v in episode.items() if k != "_index"}]}))
+                try:
+                    loaded.append(load_habitat_episodes(single, house))
+                except Exception as exc:  # noqa: BLE001 - bad input: recorded, never aborts
+                    name = episode.get("episode_id", episode["_index"])
+                    message = str(exc).replace(str(single), f"{path} episodes[{episode['_index']}]")
+                    loaded.append([EpisodeSpec(episode_id=f"{stem}/{name}", house=house_spec,
+                                               target=str(episode.get("object_category", "")), error=message)])
+    for group in loaded:
+        for episode in group:
+            if isinstance(episode, EpisodeSpec):
+                yield episode
+            else:
+                spec = EpisodeSpec.from_episode(episode, episode_id=f"{stem}/{episode.episode_id}")
+                yield replace(spec, house=house_spec)
+
+
+def read_specs(path: str | Path) -> list[EpisodeSpec]:
+    """Specs saved by ``write_specs`` (``specs.jsonl`` in an output folder)."""
+    path = _require_file(path, "specs")
+    out = []
+    with path.open("r", encoding="utf-8") as fh:
+        for number, line in enumerate(fh, start=1):
+            if line.strip():
+                try:
+                    out.append(EpisodeSpec.from_json(json.loads(line)))
+                except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+                    raise DataError(f"bad episode spec: {exc}", file=str(path), line=number) from exc
+    return out
+
+
+def write_specs(path: str | Path, specs: Sequence[EpisodeSpec]) -> None:
+    with Path(path).open("w", encoding="utf-8") as fh:
+        fh.writelines(json.dumps(spec.to_json(), sort_keys=True) + "\n" for spec in specs)

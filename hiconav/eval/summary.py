@@ -1,0 +1,139 @@
+"""Benchmark metrics from episode records: SR, SPL, DTS, failure taxonomy, timing, ablation deltas.
+
+Definitions (paper, section "Evaluation Metrics", the SR / SPL equation):
+- SR  = N_success / N_total.
+- SPL = 1/N_total * sum_i S_i * l_i^s / max(l_i^s, l_i^a)   (l^s geodesic shortest path, l^a path
+  actually travelled). Records carry their own ``spl``; ``spl_value`` recomputes it.
+- DTS = mean distance to success: geodesic distance from the final position to the success
+  region (max(0, d_goal - success distance)), as in Habitat; episodes with unknown DTS are left
+  out of its mean and counted in ``dts_unknown``.
+N_total counts every episode except ``invalid_episode`` ones (bad input: reported and counted in
+``episodes`` and ``failures``, but the navigator never ran). Runner crashes (``error``) count
+as failures.
+
+This module must not run episodes or draw plots.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import Counter
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from hiconav.eval.presets import PRESETS
+from hiconav.eval.records import EpisodeRecord
+from hiconav.eval.taxonomy import CATEGORIES, Failure
+
+
+def spl_value(success: bool, shortest: float, actual: float) -> float:
+    """S * l_s / max(l_s, l_a) for one episode (paper's SPL equation); 0 for a failure.
+
+    A zero-length shortest path with success counts 1 (already at the goal)."""
+    if not success:
+        return 0.0
+    denominator = max(shortest, actual)
+    return 1.0 if denominator <= 0 else float(shortest / denominator)
+
+
+def _mean(values: Sequence[float]) -> float | None:
+    return float(sum(values) / len(values)) if values else None
+
+
+def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
+    """Metrics of one set of records (one preset)."""
+    valid = [r for r in records if r.failure != Failure.INVALID_EPISODE.value]
+    dts_known = [float(r.dts) for r in valid if r.dts is not None and math.isfinite(r.dts)]
+    counts = Counter(r.failure for r in records)
+    failures = {c: counts.get(c, 0) for c in CATEGORIES}
+    failures.update({c: n for c, n in counts.items() if c not in failures})  # unknown labels stay visible
+    layer_seconds: dict[str, float] = {}
+    layer_frames: dict[str, int] = {}
+    for r in valid:
+        for layer, seconds in r.layer_time_s.items():
+            layer_seconds[layer] = layer_seconds.get(layer, 0.0) + float(seconds)
+        for layer, frames in r.layer_frames.items():
+            layer_frames[layer] = layer_frames.get(layer, 0) + int(frames)
+    layers = {layer: {"seconds": layer_seconds[layer], "frames": layer_frames.get(layer, 0),
+                      "seconds_per_frame": (layer_seconds[layer] / layer_frames[layer])
+                      if layer_frames.get(layer) else None}
+              for layer in sorted(layer_seconds)}
+    task_time = sum(r.task_time_s for r in valid)
+    path_length = sum(r.path_length for r in valid)
+    timing = {
+        "task_time_s_mean": _mean([r.task_time_s for r in valid]),
+        "wall_time_s_mean": _mean([r.wall_time_s for r in records]),
+        "wall_time_s_total": float(sum(r.wall_time_s for r in records)),
+        "steps_mean": _mean([float(r.steps) for r in valid]),
+        "step_speed_m_per_s": path_length / task_time if task_time > 0 else None,
+        "vlm_calls_mean": _mean([float(r.vlm_calls) for r in valid]),
+        "layers": layers,
+    }
+    by_target: dict[str, dict[str, Any]] = {}
+    for target in sorted({r.target for r in valid}):
+        group = [r for r in valid if r.target == target]
+        by_target[target] = {"episodes": len(group),
+                             "success_rate": _mean([float(r.success) for r in group]),
+                             "spl": _mean([float(r.spl) for r in group])}
+    return {
+        "episodes": len(records),
+        "valid_episodes": len(valid),
+        "success_rate": _mean([float(r.success) for r in valid]),
+        "spl": _mean([float(r.spl) for r in valid]),
+        "dts": _mean(dts_known),
+        "dts_unknown": len(valid) - len(dts_known),
+        "failures": failures,
+        "failure_rates": {c: (n / len(records) if records else 0.0) for c, n in failures.items()},
+        "timing": timing,
+        "by_target": by_target,
+        "detectors": sorted({r.detector for r in valid if r.detector}),
+        "reasoners": sorted({r.reasoner for r in valid if r.reasoner}),
+    }
+
+
+def preset_order(records: Sequence[EpisodeRecord]) -> list[str]:
+    """Presets present in ``records``: known presets in their table order, then the others."""
+    present = {r.preset for r in records}
+    return [p for p in PRESETS if p in present] + sorted(present - set(PRESETS))
+
+
+def ablation_deltas(records: Sequence[EpisodeRecord], reference: str = "full") -> dict[str, dict[str, Any]]:
+    """Each preset's SR / SPL minus the reference preset's, on the episodes both ran (paired)."""
+    valid = [r for r in records if r.failure != Failure.INVALID_EPISODE.value]
+    ref = {r.episode_id: r for r in valid if r.preset == reference}
+    out: dict[str, dict[str, Any]] = {}
+    for preset in preset_order(valid):
+        if preset == reference:
+            continue
+        pairs = [(ref[r.episode_id], r) for r in valid if r.preset == preset and r.episode_id in ref]
+        if not pairs:
+            continue
+        n = len(pairs)
+        out[preset] = {
+            "paired_episodes": n,
+            "success_rate": sum(float(b.success) for _, b in pairs) / n,
+            "spl": sum(b.spl for _, b in pairs) / n,
+            "reference_success_rate": sum(float(a.success) for a, _ in pairs) / n,
+            "reference_spl": sum(a.spl for a, _ in pairs) / n,
+            "delta_success_rate": sum(float(b.success) - float(a.success) for a, b in pairs) / n,
+            "delta_spl": sum(b.spl - a.spl for a, b in pairs) / n,
+        }
+    return out
+
+
+def summarize(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
+    """summary.json: the main preset's metrics at the top level ("full" if present, else the
+    first), every preset's under ``presets``, and paired ablation deltas under ``ablations``."""
+    order = preset_order(records)
+    presets = {p: summarize_group([r for r in records if r.preset == p]) for p in order}
+    main = "full" if "full" in presets else (order[0] if order else None)
+    top = presets[main] if main is not None else summarize_group([])
+    return {"preset": main, **top, "presets": presets,
+            "ablations": ablation_deltas(records, main) if main is not None else {}}
+
+
+def write_summary(path: str | Path, summary: dict[str, Any]) -> None:
+    Path(path).write_text(json.dumps(summary, indent=2, sort_keys=False, allow_nan=False) + "\n",
+                          encoding="utf-8")

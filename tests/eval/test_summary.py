@@ -1,0 +1,69 @@
+"""Summary math (paper's SR / SPL equation, DTS, failures, paired ablation deltas) on hand-made records."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from hiconav.eval.records import EpisodeRecord
+from hiconav.eval.summary import spl_value, summarize
+
+
+def rec(i: int, preset: str = "full", **kw) -> EpisodeRecord:
+    kw.setdefault("failure", "success" if kw.get("success") else "step_out")
+    return EpisodeRecord(episode_id=f"e{i}", house="h", target=kw.pop("target", "bed"), preset=preset, **kw)
+
+
+def test_spl_value_is_success_times_shortest_over_longer_path() -> None:
+    assert spl_value(True, 4.0, 8.0) == pytest.approx(0.5)
+    assert spl_value(True, 4.0, 2.0) == pytest.approx(1.0)  # max(l_s, l_a) caps it at 1
+    assert spl_value(False, 4.0, 4.0) == 0.0
+    assert spl_value(True, 0.0, 0.0) == 1.0
+
+
+def test_sr_spl_dts_are_means_over_valid_episodes() -> None:
+    records = [
+        rec(0, success=True, spl=spl_value(True, 5.0, 10.0), dts=0.0, target="bed"),
+        rec(1, success=True, spl=spl_value(True, 3.0, 3.0), dts=0.0, target="tv"),
+        rec(2, success=False, spl=0.0, dts=2.5, failure="false_positive", target="tv"),
+        rec(3, success=False, spl=0.0, dts=math.inf, failure="no_frontier"),  # unknown DTS
+        rec(4, success=False, failure="invalid_episode", error="start not navigable", error_kind="data"),
+    ]
+    s = summarize(records)
+    assert s["episodes"] == 5 and s["valid_episodes"] == 4
+    assert s["success_rate"] == pytest.approx(2 / 4)
+    assert s["spl"] == pytest.approx((0.5 + 1.0) / 4)
+    assert s["dts"] == pytest.approx((0.0 + 0.0 + 2.5) / 3)
+    assert s["dts_unknown"] == 1
+    assert s["failures"]["success"] == 2 and s["failures"]["false_positive"] == 1
+    assert s["failures"]["no_frontier"] == 1 and s["failures"]["invalid_episode"] == 1
+    assert s["failures"]["stuck"] == 0
+    assert s["by_target"]["tv"] == {"episodes": 2, "success_rate": 0.5, "spl": 0.5}
+
+
+def test_timing_is_seconds_per_frame_per_layer_and_step_speed() -> None:
+    records = [rec(0, success=True, spl=1.0, task_time_s=10.0, path_length=5.0, wall_time_s=2.0,
+                   layer_time_s={"fast": 1.0, "reasoning": 4.0}, layer_frames={"fast": 100, "reasoning": 2}),
+               rec(1, task_time_s=30.0, path_length=10.0, wall_time_s=4.0, vlm_calls=3,
+                   layer_time_s={"fast": 2.0}, layer_frames={"fast": 100})]
+    timing = summarize(records)["timing"]
+    assert timing["layers"]["fast"]["seconds_per_frame"] == pytest.approx(3.0 / 200)
+    assert timing["layers"]["reasoning"]["seconds_per_frame"] == pytest.approx(2.0)
+    assert timing["task_time_s_mean"] == pytest.approx(20.0)
+    assert timing["step_speed_m_per_s"] == pytest.approx(15.0 / 40.0)
+    assert timing["wall_time_s_total"] == pytest.approx(6.0)
+    assert timing["vlm_calls_mean"] == pytest.approx(1.5)
+
+
+def test_ablation_deltas_are_paired_on_common_episodes_with_sign() -> None:
+    records = [rec(0, success=True, spl=0.8), rec(1, success=True, spl=0.6), rec(2, success=False),
+               rec(0, "no_vis", success=True, spl=0.4), rec(1, "no_vis", success=False),
+               rec(5, "no_vis", success=True, spl=1.0)]  # e5 has no full run: not paired
+    s = summarize(records)
+    assert s["preset"] == "full" and set(s["presets"]) == {"full", "no_vis"}
+    delta = s["ablations"]["no_vis"]
+    assert delta["paired_episodes"] == 2
+    assert delta["delta_success_rate"] == pytest.approx(-0.5)
+    assert delta["delta_spl"] == pytest.approx(((0.4 - 0.8) + (0.0 - 0.6)) / 2)
+    assert s["success_rate"] == pytest.approx(2 / 3)  # top level = the full preset
