@@ -1,0 +1,189 @@
+"""ObjectNav episodes: a seeded generator for any house and a reader for Habitat episode files.
+
+An episode = start pose on free floor that is connected to a goal instance of the target
+category, the goal instance ids (every instance of that category in the house), the geodesic
+start-to-goal distance and an instruction ("find the bed"). Generation is deterministic per
+(house, n, seed). This module builds episodes; it must not run them (see ``metrics``).
+"""
+
+from __future__ import annotations
+
+import gzip
+import json
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hiconav.errors import DataError
+from hiconav.sim.geodesic import GoalDistance, house_graph
+from hiconav.sim.house import House
+from hiconav.types import Pose2D
+
+# Categories a user would ask for (Habitat's six first, then ProcTHOR furniture/appliances).
+TARGET_CATEGORIES: tuple[str, ...] = (
+    "chair", "sofa", "bed", "toilet", "tv", "plant",
+    "dining_table", "fridge", "sink", "laptop", "armchair", "desk", "dresser", "microwave",
+    "toaster", "coffee_machine", "washing_machine", "clothes_dryer", "floor_lamp", "desk_lamp",
+    "side_table", "tv_stand", "shelving_unit", "garbage_can", "oven", "bathtub", "stool",
+    "safe", "teddy_bear", "statue", "vase", "painting", "laundry_hamper", "dog_bed",
+)
+
+
+# Gibson ObjectNav v1.1 uses only these six goal categories (data README).
+GIBSON_GOAL_CATEGORIES: tuple[str, ...] = ("chair", "sofa", "plant", "bed", "toilet", "tv")
+
+
+@dataclass(frozen=True)
+class Episode:
+    """One ObjectNav episode (world frame; distances in metres)."""
+
+    episode_id: str
+    house: str
+    start: Pose2D
+    target: str
+    goal_instance_ids: tuple[int, ...]
+    geodesic_distance: float
+    instruction: str
+
+    def to_json(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["start"] = [self.start.x, self.start.y, self.start.yaw]
+        d["goal_instance_ids"] = list(self.goal_instance_ids)
+        return d
+
+
+def instruction_for(category: str) -> str:
+    return f"find the {category.replace('_', ' ')}"
+
+
+def _resolve(house: House | str) -> House:
+    if isinstance(house, House):
+        return house
+    from hiconav.sim.houses import load_house
+
+    return load_house(house)
+
+
+def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: float = 0.18,
+                      min_distance: float = 1.5, max_distance: float = 30.0,
+                      categories: tuple[str, ...] | None = None) -> list[Episode]:
+    """``n`` episodes in ``house``; deterministic for a given (house, n, seed).
+
+    The target is drawn uniformly among the categories in ``categories`` (default
+    ``GIBSON_GOAL_CATEGORIES`` for Gibson houses, as in Gibson ObjectNav, else
+    ``TARGET_CATEGORIES``) that are present and reachable; the start is a uniformly drawn free
+    cell whose geodesic distance to the target lies in [min_distance, max_distance], with a
+    uniform yaw. Raises ``DataError`` if the house has no reachable target category.
+    """
+    house = _resolve(house)
+    allowed = categories or (GIBSON_GOAL_CATEGORIES if house.name.startswith("gibson:")
+                             else TARGET_CATEGORIES)
+    present = sorted(c for c in house.categories if c in allowed)
+    rng = np.random.default_rng(seed)
+    fields: dict[str, tuple[GoalDistance, np.ndarray]] = {}
+    usable: list[str] = []
+    graph = house_graph(house, radius)
+    for cat in present:
+        ids = tuple(o.instance_id for o in house.instances_of(cat))
+        gd = GoalDistance(house, instance_ids=ids, radius=radius)
+        ok = graph.mask & np.isfinite(gd.field) & (gd.field >= min_distance) & \
+            (gd.field <= max_distance)
+        cells = np.argwhere(ok)
+        if len(cells):
+            fields[cat] = (gd, cells)
+            usable.append(cat)
+    if not usable:
+        raise DataError(f"{house.name} has no reachable target category (present: "
+                        f"{', '.join(sorted(house.categories)) or 'none'})", field="target")
+    episodes = []
+    for i in range(n):
+        cat = usable[int(rng.integers(len(usable)))]
+        gd, cells = fields[cat]
+        rc = cells[int(rng.integers(len(cells)))]
+        xy = house.nav.cell_to_world(rc)
+        yaw = float(rng.uniform(-math.pi, math.pi))
+        episodes.append(Episode(
+            episode_id=f"{house.name}#{seed}-{i}", house=house.name,
+            start=Pose2D(float(xy[0]), float(xy[1]), yaw), target=cat,
+            goal_instance_ids=gd.instance_ids, geodesic_distance=float(gd.field[rc[0], rc[1]]),
+            instruction=instruction_for(cat)))
+    return episodes
+
+
+def load_habitat_episodes(path: str | Path, house: House | str, *,
+                          radius: float = 0.18) -> list[Episode]:
+    """Read a Habitat ObjectNav ``*_episodes.json(.gz)`` file for one (Gibson) house.
+
+    Positions are converted with the Gibson mapping (world = (z_h, x_h, y_h - floor_height),
+    see ``gibson.py``). Episodes of other scenes (``scene_id`` basename) or other floors
+    (``floor_id``) are skipped. A start outside the map, a missing field or an unknown
+    category raises ``DataError`` naming the file and field.
+    """
+    from hiconav.sim.gibson import HABITAT_GOAL_NAMES, HABITAT_TO_CATEGORY, habitat_to_world, habitat_yaw
+
+    house = _resolve(house)
+    path = Path(path)
+    try:
+        opener = gzip.open if path.suffix == ".gz" else open
+        with opener(path, "rt", encoding="utf-8") as fh:
+            data = json.load(fh)
+    except json.JSONDecodeError as exc:
+        raise DataError(f"malformed episode JSON: {exc.msg}", file=str(path),
+                        line=exc.lineno) from exc
+    except OSError as exc:
+        raise DataError(f"cannot read episode file: {exc}", file=str(path)) from exc
+    if not isinstance(data, dict) or not isinstance(data.get("episodes"), list):
+        raise DataError("expected an object with an 'episodes' list", file=str(path),
+                        field="episodes")
+    scene = house.name.split(":", 1)[-1].split("/")[0]
+    floor = int(house.name.split("/")[1]) if "/" in house.name.split(":", 1)[-1] else 0
+    out: list[Episode] = []
+    nav = house.nav
+    for i, ep in enumerate(data["episodes"]):
+        where = f"episodes[{i}]"
+        try:
+            scene_id = str(ep["scene_id"])
+            ep_scene = Path(scene_id).name.split(".")[0]
+            if ep_scene != scene:
+                continue
+            if "floor_id" in ep and ep["floor_id"] is not None and int(ep["floor_id"]) != floor:
+                continue
+            pos = np.asarray(ep["start_position"], dtype=np.float64)
+            quat = np.asarray(ep["start_rotation"], dtype=np.float64)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise DataError(f"missing or invalid field {exc}", file=str(path),
+                            field=where) from exc
+        if pos.shape != (3,) or quat.shape != (4,):
+            raise DataError("start_position must be [x, y, z] and start_rotation [x, y, z, w]",
+                            file=str(path), field=f"{where}.start_position")
+        world = habitat_to_world(pos, house.floor_height)
+        rc = nav.world_to_cell(world[:2])
+        if not nav.in_bounds(rc):
+            raise DataError(
+                f"start {pos.tolist()} maps to cell {rc.tolist()} outside the {nav.shape} map "
+                f"of {house.name}", file=str(path), field=f"{where}.start_position")
+        name = ep.get("object_category")
+        if name is None and "object_id" in ep:
+            k = int(ep["object_id"])
+            if not 0 <= k < len(HABITAT_GOAL_NAMES):
+                raise DataError(f"object_id {k} is not in 0..5", file=str(path),
+                                field=f"{where}.object_id")
+            name = HABITAT_GOAL_NAMES[k]
+        category = HABITAT_TO_CATEGORY.get(str(name)) if name is not None else None
+        if category is None:
+            raise DataError(f"unknown object category {name!r}", file=str(path),
+                            field=f"{where}.object_category")
+        ids = tuple(o.instance_id for o in house.instances_of(category))
+        if not ids:
+            raise DataError(f"{house.name} has no '{category}' instance", file=str(path),
+                            field=f"{where}.object_category")
+        gd = GoalDistance(house, instance_ids=ids, radius=radius)
+        out.append(Episode(
+            episode_id=str(ep.get("episode_id", i)), house=house.name,
+            start=Pose2D(float(world[0]), float(world[1]), habitat_yaw(quat)), target=category,
+            goal_instance_ids=ids, geodesic_distance=gd.distance(world[:2]),
+            instruction=instruction_for(category)))
+    return out

@@ -1,0 +1,223 @@
+"""Geodesic distances on the navigable grid (Dijkstra with scipy.sparse.csgraph).
+
+The robot's centre may occupy a cell when the cell's clearance (distance from its centre to the
+nearest non-navigable cell, minus half a cell) is at least the robot radius: that is the
+*traversable* mask. Paths move between 8-connected traversable cells (step 1 or sqrt(2) cells)
+and never cut a corner (a diagonal step needs both orthogonal neighbours traversable).
+
+The distance to a goal object is one multi-source Dijkstra run: every traversable cell within
+``VIEW_RADIUS`` (1.0 m, Euclidean) of the object's footprint is a *view point* (as Habitat's
+ObjectNav goal view points) and a source whose initial value is its Euclidean distance to the
+nearest footprint cell; if no traversable cell is that close the reach grows by 1.5x up to
+3 m (a labelled fallback for objects in cluttered corners of the scanned Gibson maps, whose
+navigable channel keeps a gap around furniture). So ``GoalDistance.distance(xy)`` is the
+geodesic distance from the robot centre to the nearest goal footprint. This module computes distances only;
+it must not move the robot or render.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
+import numpy as np
+from scipy import ndimage
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from hiconav.errors import DataError
+from hiconav.sim.house import House, NavGrid
+
+if TYPE_CHECKING:
+    from hiconav.sim.episodes import Episode
+
+SQRT2 = math.sqrt(2.0)
+VIEW_RADIUS = 1.0  # m: traversable cells this close to a goal footprint are its view points
+
+
+def clearance(nav: NavGrid) -> np.ndarray:
+    """(H, W) float64 metres from each cell centre to the nearest blocked cell's edge.
+
+    Cells outside the grid count as blocked. Non-navigable cells have clearance <= 0.
+    """
+    padded = np.pad(nav.navigable, 1, constant_values=False)
+    edt = ndimage.distance_transform_edt(padded)[1:-1, 1:-1]
+    return edt * nav.resolution - nav.resolution / 2.0
+
+
+def traversable(nav: NavGrid, radius: float) -> np.ndarray:
+    """(H, W) bool: cells where a robot disc of ``radius`` m centred in the cell fits."""
+    return clearance(nav) >= radius - 1e-9
+
+
+class GridGraph:
+    """8-connected graph over a (H, W) bool mask; node k is the k-th True cell (row-major)."""
+
+    def __init__(self, mask: np.ndarray, resolution: float) -> None:
+        self.mask = np.asarray(mask, dtype=bool)
+        self.resolution = float(resolution)
+        h, w = self.mask.shape
+        self.index = np.full((h, w), -1, dtype=np.int64)
+        rr, cc = np.nonzero(self.mask)
+        self.cells = np.stack([rr, cc], axis=1)
+        self.n = len(rr)
+        self.index[rr, cc] = np.arange(self.n)
+        rows, cols, wts = [], [], []
+        m = self.mask
+        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
+            a = np.zeros_like(m)
+            # a[r, c] True when (r, c) and (r + dr, c + dc) are both traversable.
+            r0, r1 = 0, h - dr
+            c0, c1 = max(0, -dc), w - max(0, dc)
+            a[r0:r1, c0:c1] = m[r0:r1, c0:c1] & m[r0 + dr:r1 + dr, c0 + dc:c1 + dc]
+            if dr and dc:  # no corner cutting
+                a[r0:r1, c0:c1] &= m[r0 + dr:r1 + dr, c0:c1] & m[r0:r1, c0 + dc:c1 + dc]
+            ar, ac = np.nonzero(a)
+            rows.append(self.index[ar, ac])
+            cols.append(self.index[ar + dr, ac + dc])
+            wts.append(np.full(len(ar), (SQRT2 if dr and dc else 1.0) * self.resolution))
+        self.rows = np.concatenate(rows)
+        self.cols = np.concatenate(cols)
+        self.wts = np.concatenate(wts)
+
+    def multi_source(self, cells: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+        """(H, W) float64 min over sources s of offsets[s] + path length(s, cell); inf if none.
+
+        cells: (K, 2) traversable (row, col) sources; offsets: (K,) metres >= 0.
+        """
+        h, w = self.mask.shape
+        out = np.full((h, w), np.inf)
+        if len(cells) == 0 or self.n == 0:
+            return out
+        src = self.index[cells[:, 0], cells[:, 1]]
+        if np.any(src < 0):
+            raise ValueError("every source cell must be traversable")
+        super_node = self.n
+        # Zero weights would be dropped by the sparse matrix: add a negligible epsilon.
+        rows = np.concatenate([self.rows, self.cols, np.full(len(src), super_node)])
+        cols = np.concatenate([self.cols, self.rows, src])
+        wts = np.concatenate([self.wts, self.wts, np.asarray(offsets, dtype=np.float64) + 1e-9])
+        graph = coo_matrix((wts, (rows, cols)), shape=(self.n + 1, self.n + 1)).tocsr()
+        dist = dijkstra(graph, directed=True, indices=super_node)
+        out[self.cells[:, 0], self.cells[:, 1]] = dist[: self.n]
+        return out
+
+
+def house_graph(house: House, radius: float) -> GridGraph:
+    """The traversable-cell graph of a house for a robot radius (cached on the house)."""
+    key = ("graph", round(radius, 6))
+    graph = house._cache.get(key)
+    if graph is None:
+        graph = GridGraph(traversable(house.nav, radius), house.nav.resolution)
+        house._cache[key] = graph
+    return graph
+
+
+def goal_sources(graph: GridGraph, footprint: np.ndarray, resolution: float, radius: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Traversable source cells near a footprint ((N, 2) cells) and their offsets (m)."""
+    h, w = graph.mask.shape
+    foot = np.zeros((h, w), dtype=bool)
+    if len(footprint):
+        foot[footprint[:, 0], footprint[:, 1]] = True
+    if not foot.any():
+        return np.zeros((0, 2), dtype=np.int64), np.zeros(0)
+    dist = ndimage.distance_transform_edt(~foot) * resolution
+    reach = max(VIEW_RADIUS, radius + 1.5 * resolution)
+    while reach <= 3.0 + 1e-9:
+        sel = graph.mask & (dist <= reach)
+        if sel.any():
+            rr, cc = np.nonzero(sel)
+            return np.stack([rr, cc], axis=1), dist[rr, cc]
+        reach *= 1.5
+    return np.zeros((0, 2), dtype=np.int64), np.zeros(0)
+
+
+class GoalDistance:
+    """Geodesic distance (m) from any robot position to the nearest goal instance footprint.
+
+    ``GoalDistance(house, episode)`` uses ``episode.goal_instance_ids``; alternatively pass
+    ``instance_ids=...``. ``field``: (H, W) float64 metres, inf where unreachable.
+    """
+
+    def __init__(self, house: House, episode: Episode | None = None, *,
+                 instance_ids: Iterable[int] | None = None, radius: float = 0.18) -> None:
+        ids = tuple(instance_ids) if instance_ids is not None else \
+            tuple(episode.goal_instance_ids) if episode is not None else ()
+        if not ids:
+            raise DataError("GoalDistance needs at least one goal instance id",
+                            field="goal_instance_ids")
+        for i in ids:
+            if not 0 <= i < len(house.objects):
+                raise DataError(f"goal instance {i} is not an object of {house.name} "
+                                f"(0..{len(house.objects) - 1})", field="goal_instance_ids")
+        self.house = house
+        self.instance_ids = ids
+        self.radius = float(radius)
+        key = ("goal", ids, round(self.radius, 6))
+        cached = house._cache.get(key)
+        if cached is None:
+            graph = house_graph(house, self.radius)
+            foot = np.concatenate([house.footprint(i) for i in ids])
+            cells, offsets = goal_sources(graph, foot, house.nav.resolution, self.radius)
+            cached = graph.multi_source(cells, offsets)
+            cached.flags.writeable = False
+            house._cache[key] = cached
+        self.field: np.ndarray = cached
+
+    def distance(self, xy: np.ndarray) -> float:
+        """Geodesic metres from world ``xy`` (2,) to the nearest goal footprint (inf if none).
+
+        A position whose cell is not traversable (e.g. a start pressed against a wall) uses the
+        nearest reachable cell within 0.5 m plus the straight distance to it.
+        """
+        nav = self.house.nav
+        rc = nav.world_to_cell(np.asarray(xy, dtype=np.float64)[:2])
+        if nav.in_bounds(rc) and np.isfinite(self.field[rc[0], rc[1]]):
+            return float(self.field[rc[0], rc[1]])
+        r = math.ceil(0.5 / nav.resolution)
+        h, w = nav.shape
+        r0, r1 = max(rc[0] - r, 0), min(rc[0] + r + 1, h)
+        c0, c1 = max(rc[1] - r, 0), min(rc[1] + r + 1, w)
+        if r1 <= r0 or c1 <= c0:
+            return math.inf
+        win = self.field[r0:r1, c0:c1]
+        rr, cc = np.nonzero(np.isfinite(win))
+        if len(rr) == 0:
+            return math.inf
+        centres = nav.cell_to_world(np.stack([rr + r0, cc + c0], axis=1))
+        d = np.linalg.norm(centres - np.asarray(xy)[:2], axis=1) + win[rr, cc]
+        return float(d.min())
+
+    def next_cell(self, rc: np.ndarray) -> np.ndarray | None:
+        """The 8-neighbour of cell ``rc`` with the smallest distance (descent step), or None."""
+        h, w = self.field.shape
+        best, best_d = None, self.field[rc[0], rc[1]]
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                r, c = rc[0] + dr, rc[1] + dc
+                if (dr or dc) and 0 <= r < h and 0 <= c < w and self.field[r, c] < best_d:
+                    best, best_d = np.array([r, c]), self.field[r, c]
+        return best
+
+    def path(self, xy: np.ndarray, max_cells: int = 100000) -> np.ndarray:
+        """(N, 2) world xy cell centres of a shortest path from ``xy`` to the goal region."""
+        nav = self.house.nav
+        rc = nav.world_to_cell(np.asarray(xy)[:2])
+        if not nav.in_bounds(rc) or not np.isfinite(self.field[rc[0], rc[1]]):
+            return np.zeros((0, 2))
+        cells = [rc]
+        for _ in range(max_cells):
+            nxt = self.next_cell(cells[-1])
+            if nxt is None:
+                break
+            cells.append(nxt)
+        return nav.cell_to_world(np.array(cells))
+
+
+def point_distance_field(house: House, xy: np.ndarray, radius: float = 0.18) -> np.ndarray:
+    """(H, W) geodesic metres from a world point ``xy`` (its cell must be traversable)."""
+    graph = house_graph(house, radius)
+    rc = house.nav.world_to_cell(np.asarray(xy)[:2])
+    return graph.multi_source(rc[None, :], np.zeros(1))

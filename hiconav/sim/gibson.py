@@ -1,0 +1,198 @@
+"""Gibson top-down semantic maps (SemExp / L3MVN ``train_info.pbz2``) -> ``House``.
+
+Each floor is a (16, H, W) 0/1 map at 5 cm: channel 0 is the navigable floor (cleaned of
+scan speckle, see ``clean_floor``), channels 1-15
+the categories in ``CHANNEL_CATEGORIES``. Every 8-connected component of a category channel
+becomes one object instance, extruded between a typical bottom and top height per category
+(``EXTRUSION``; footprints have no heights in the source). All other (non-navigable, non-object)
+cells are walls/clutter of the full wall height; only their faces that border the floor or an
+object are rendered (merged along straight runs), which keeps the mesh small.
+
+Coordinates (data README): a Habitat position (x_h, y_h, z_h) (y up, right-handed) lies in
+cell row = int((x_h - origin[1]/100) * 20), col = int((z_h - origin[0]/100) * 20). Our grid
+rows run along world y and columns along world x, so the world point is
+(x, y, z) = (z_h, x_h, y_h - floor_height): a cyclic permutation, hence right-handed, and the
+map is used as is with grid origin (origin[0]/100, origin[1]/100) metres.
+
+This module reads the map file and builds a ``House``; it must not render or simulate.
+"""
+
+from __future__ import annotations
+
+import bz2
+import math
+import pickle
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+
+from hiconav.errors import DataError
+from hiconav.sim.house import House, NavGrid, QuadSet, SimObject, mask_side_quads
+from hiconav.sim.procthor import category_color
+
+RESOLUTION = 0.05
+WALL_HEIGHT = 2.6  # m
+
+# Channel k (1-based) of sem_map -> category (Habitat names mapped to ours).
+CHANNEL_CATEGORIES = ("chair", "sofa", "plant", "bed", "toilet", "tv", "dining_table", "oven",
+                      "sink", "fridge", "book", "clock", "vase", "cup", "bottle")
+# The Habitat/Gibson ObjectNav names of the 6 goal categories (episode object_id indexes this).
+HABITAT_GOAL_NAMES = ("chair", "couch", "potted plant", "bed", "toilet", "tv")
+HABITAT_TO_CATEGORY = {"chair": "chair", "couch": "sofa", "potted plant": "plant",
+                       "potted_plant": "plant", "bed": "bed", "toilet": "toilet", "tv": "tv",
+                       "tv_monitor": "tv", "dining-table": "dining_table",
+                       "dining table": "dining_table", "refrigerator": "fridge", "oven": "oven",
+                       "sink": "sink", "book": "book", "clock": "clock", "vase": "vase",
+                       "cup": "cup", "bottle": "bottle", "sofa": "sofa", "plant": "plant"}
+# (bottom, top) metres above the floor: typical heights of each category (assumption).
+EXTRUSION = {
+    "chair": (0.0, 0.9), "sofa": (0.0, 0.85), "plant": (0.0, 0.9), "bed": (0.0, 0.6),
+    "toilet": (0.0, 0.75), "tv": (0.5, 1.2), "dining_table": (0.0, 0.76), "oven": (0.0, 0.9),
+    "sink": (0.0, 0.9), "fridge": (0.0, 1.8), "book": (0.75, 0.95), "clock": (1.6, 1.9),
+    "vase": (0.75, 1.05), "cup": (0.75, 0.85), "bottle": (0.75, 1.0),
+}
+EIGHT = np.ones((3, 3), dtype=bool)
+SPECKLE_CELLS = 30  # enclosed non-floor holes smaller than this (0.075 m^2) are scan noise
+
+
+@lru_cache(maxsize=2)
+def load_info(path: str) -> dict[str, Any]:
+    """The decompressed ``{scene: {floor: {sem_map, origin, floor_height}}}`` (cached)."""
+    try:
+        with bz2.BZ2File(path) as fh:
+            info = pickle.load(fh)
+    except (OSError, EOFError, pickle.UnpicklingError) as exc:
+        raise DataError(f"cannot read the Gibson maps: {exc}", file=path) from exc
+    if not isinstance(info, dict):
+        raise DataError("expected a dict {scene: {floor: ...}}", file=path)
+    return info
+
+
+def info_path(data_dir: Path) -> str:
+    return str(data_dir / "gibson" / "train_info.pbz2")
+
+
+def scene_names(data_dir: Path) -> list[str]:
+    return sorted(load_info(info_path(data_dir)))
+
+
+def habitat_to_world(pos: np.ndarray, floor_height: float = 0.0) -> np.ndarray:
+    """Habitat (..., 3) (x_h, y_h, z_h) -> world (..., 3) (z_h, x_h, y_h - floor_height)."""
+    p = np.asarray(pos, dtype=np.float64)
+    return np.stack([p[..., 2], p[..., 0], p[..., 1] - floor_height], axis=-1)
+
+
+def habitat_yaw(quat_xyzw: np.ndarray) -> float:
+    """World yaw (rad) of a Habitat agent rotation quaternion [x, y, z, w].
+
+    The agent looks along -z_h; we rotate that vector by the quaternion and express it in the
+    world frame (x = z_h, y = x_h).
+    """
+    x, y, z, w = (float(v) for v in quat_xyzw)
+    v = np.array([0.0, 0.0, -1.0])
+    q = np.array([x, y, z])
+    t = 2.0 * np.cross(q, v)
+    r = v + w * t + np.cross(q, t)
+    return math.atan2(r[0], r[2])
+
+
+def floor_record(data_dir: Path, scene: str, floor: int) -> dict[str, Any]:
+    path = info_path(data_dir)
+    info = load_info(path)
+    if scene not in info:
+        raise DataError(f"unknown Gibson scene '{scene}'; valid: {', '.join(sorted(info))}",
+                        file=path)
+    floors = info[scene]
+    if floor not in floors:
+        raise DataError(f"scene {scene} has no floor {floor}; floors: {sorted(floors)}",
+                        file=path, field=f"{scene}")
+    rec = floors[floor]
+    for key in ("sem_map", "origin"):
+        if key not in rec:
+            raise DataError(f"missing field '{key}'", file=path, field=f"{scene}.{floor}.{key}")
+    sem = np.asarray(rec["sem_map"])
+    if sem.ndim != 3 or sem.shape[0] != 16:
+        raise DataError(f"sem_map must have shape (16, H, W), got {sem.shape}", file=path,
+                        field=f"{scene}.{floor}.sem_map")
+    return rec
+
+
+def component_counts(sem_map: np.ndarray) -> list[int]:
+    """Number of 8-connected components of each category channel 1..15."""
+    return [int(ndimage.label(sem_map[k] > 0, structure=EIGHT)[1]) for k in range(1, 16)]
+
+
+def clean_floor(floor: np.ndarray, objects: np.ndarray) -> np.ndarray:
+    """(H, W) bool navigable floor with the scan's speckle removed.
+
+    In several scans (Klickitat, Lakeville, Woodbine, ...) channel 0 is a sparse projection
+    of the floor: isolated missing cells everywhere, so no 0.36 m robot would fit anywhere.
+    We apply one 3x3 binary closing (fills gaps of at most 2 cells, 10 cm, so walls of the
+    map, which are thicker, stay closed) and fill enclosed non-floor holes smaller than
+    ``SPECKLE_CELLS``; object cells are never made navigable.
+    """
+    closed = ndimage.binary_closing(floor, structure=EIGHT, iterations=1, border_value=0)
+    closed |= floor
+    closed &= ~objects
+    labels, _ = ndimage.label(~closed)
+    sizes = np.bincount(labels.ravel())
+    small = sizes < SPECKLE_CELLS
+    small[0] = False
+    return (closed | small[labels]) & ~objects
+
+
+def load_gibson(scene: str, floor: int, data_dir: Path) -> House:
+    """Build the ``House`` of one Gibson floor."""
+    rec = floor_record(data_dir, scene, floor)
+    sem = np.asarray(rec["sem_map"]) > 0
+    origin = np.asarray(rec["origin"], dtype=np.float64) / 100.0  # (x_w, y_w) = (z_h, x_h)
+    floor_height = float(rec.get("floor_height", 0.0))
+    nav_mask = sem[0]
+    objects: list[SimObject] = []
+    quads: list[QuadSet] = []
+    footprints: dict[int, np.ndarray] = {}
+    any_object = np.zeros_like(nav_mask)
+    for k, cat in enumerate(CHANNEL_CATEGORIES, start=1):
+        labels, n = ndimage.label(sem[k], structure=EIGHT)
+        if n == 0:
+            continue
+        any_object |= sem[k]
+        z0, z1 = EXTRUSION[cat]
+        slices = ndimage.find_objects(labels)
+        for lab, sl in enumerate(slices, start=1):
+            window = labels[sl] == lab
+            rr, cc = np.nonzero(window)
+            rr = rr + sl[0].start
+            cc = cc + sl[1].start
+            iid = len(objects)
+            x0 = origin[0] + sl[1].start * RESOLUTION
+            x1 = origin[0] + sl[1].stop * RESOLUTION
+            y0 = origin[1] + sl[0].start * RESOLUTION
+            y1 = origin[1] + sl[0].stop * RESOLUTION
+            objects.append(SimObject(
+                iid, cat, np.array([(x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2]),
+                np.array([x1 - x0, y1 - y0, z1 - z0]), 0.0, f"sem_map[{k}]"))
+            cells = np.stack([rr, cc], axis=1).astype(np.int64)
+            cells.flags.writeable = False
+            footprints[iid] = cells
+            win_origin = np.array([x0, y0])
+            shade = 0.85 + 0.3 * ((iid * 0.6180339) % 1.0)
+            color = tuple(np.clip(np.array(category_color(cat)) * shade, 0, 1))
+            quads.append(mask_side_quads(window, win_origin, RESOLUTION, z0, z1, color, iid,
+                                         "object", top=True))
+    # Walls / clutter: every other cell, drawn as the vertical faces that border the floor
+    # or an object (the only faces visible from the floor; the ceiling covers their tops).
+    nav_mask = clean_floor(nav_mask, any_object)
+    clutter = ~(nav_mask | any_object)
+    quads.append(mask_side_quads(clutter, origin, RESOLUTION, 0.0, WALL_HEIGHT,
+                                 (0.8, 0.78, 0.74), material="wall"))
+    nav = NavGrid(clean_floor(nav_mask, any_object), origin, RESOLUTION)
+    name = f"gibson:{scene}" if floor == 0 else f"gibson:{scene}/{floor}"
+    return House(name=name, objects=objects, nav=nav, rooms=[], boxes=[],
+                 quads=QuadSet.concat(quads),
+                 footprints=footprints, wall_height=WALL_HEIGHT,
+                 floor_color=(0.5, 0.47, 0.42), source=info_path(data_dir),
+                 floor_height=floor_height)

@@ -1,0 +1,201 @@
+"""The agent in a house: Habitat-style discrete actions and continuous (v, omega, dt) motion
+with collisions against the navigable grid, and RGB-D + instance observations.
+
+Collision model: the robot is a disc of ``robot_radius``; its centre may only be where the
+cell's clearance (``geodesic.clearance``) is at least the radius, so the disc never overlaps a
+wall or object cell. Motion is integrated in sub-steps of at most half a cell; at the first
+sub-step that would leave free space the robot stops there (no sliding) and ``collided`` is
+set for that step. Simulated time advances ``ACTION_SECONDS`` per discrete action and ``dt``
+per velocity step. This module moves the robot and renders; it must not plan or decide.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+
+import numpy as np
+
+from hiconav.errors import HiconavError
+from hiconav.sim.config import SimConfig
+from hiconav.sim.geodesic import clearance
+from hiconav.sim.house import House
+from hiconav.types import (
+    CameraIntrinsics,
+    DiscreteAction,
+    Frame,
+    Pose2D,
+    VelocityCommand,
+    camera_pose_from_base,
+    wrap_angle,
+)
+
+ACTION_SECONDS = 0.5  # simulated seconds per discrete action
+
+
+class SimulatorError(HiconavError):
+    """An invalid request to the simulator (e.g. a start pose inside a wall)."""
+
+
+class Simulator:
+    """One robot in one house. ``reset`` -> ``step`` / ``step_velocity`` -> ``Frame``."""
+
+    def __init__(self, house: House, config: SimConfig | None = None, seed: int = 0) -> None:
+        self.house = house
+        self.config = config or SimConfig()
+        self.seed = seed
+        self.rng = np.random.default_rng(seed)
+        c = self.config
+        self.intrinsics = CameraIntrinsics.from_hfov(c.width, c.height, c.hfov_deg)
+        self.clearance = clearance(house.nav)
+        self.free = self.clearance >= c.robot_radius - 1e-9  # (H, W) robot-centre cells
+        self._renderer = None
+        self.pose = Pose2D(0.0, 0.0, 0.0)
+        self.tilt = 0.0  # rad, positive looking up
+        self.collided = False
+        self.steps = 0
+        self.time = 0.0
+        self.path_length = 0.0
+        self.collisions = 0
+        self.stopped = False
+        self._seq = 0
+
+    # ----------------------------------------------------------------------------- state
+    def is_free(self, xy: np.ndarray) -> bool:
+        """True where the robot disc centred at world ``xy`` touches no blocked cell."""
+        rc = self.house.nav.world_to_cell(np.asarray(xy, dtype=np.float64)[:2])
+        h, w = self.free.shape
+        return bool(0 <= rc[0] < h and 0 <= rc[1] < w and self.free[rc[0], rc[1]])
+
+    def nearest_free(self, xy: np.ndarray, max_dist: float = 0.3) -> np.ndarray | None:
+        """Centre of the nearest free cell within ``max_dist`` m of ``xy``, or None."""
+        nav = self.house.nav
+        rc = nav.world_to_cell(np.asarray(xy, dtype=np.float64)[:2])
+        r = math.ceil(max_dist / nav.resolution)
+        h, w = self.free.shape
+        r0, r1 = max(rc[0] - r, 0), min(rc[0] + r + 1, h)
+        c0, c1 = max(rc[1] - r, 0), min(rc[1] + r + 1, w)
+        if r1 <= r0 or c1 <= c0:
+            return None
+        rr, cc = np.nonzero(self.free[r0:r1, c0:c1])
+        if len(rr) == 0:
+            return None
+        centres = nav.cell_to_world(np.stack([rr + r0, cc + c0], axis=1))
+        d = np.linalg.norm(centres - np.asarray(xy)[:2], axis=1)
+        k = int(np.argmin(d))
+        return centres[k] if d[k] <= max_dist else None
+
+    def reset(self, start: Pose2D, tilt: float = 0.0) -> Frame:
+        """Place the robot at ``start`` (snapped to the nearest free cell within 0.3 m)."""
+        xy = np.array([start.x, start.y])
+        if not self.is_free(xy):
+            snapped = self.nearest_free(xy)
+            if snapped is None:
+                raise SimulatorError(
+                    f"start ({start.x:.2f}, {start.y:.2f}) in {self.house.name} is not on free "
+                    f"floor (robot radius {self.config.robot_radius} m)", field="start")
+            xy = snapped
+        self.pose = Pose2D(float(xy[0]), float(xy[1]), wrap_angle(start.yaw))
+        self.tilt = float(tilt)
+        self.collided = False
+        self.steps = 0
+        self.time = 0.0
+        self.path_length = 0.0
+        self.collisions = 0
+        self.stopped = False
+        return self.observe()
+
+    # ----------------------------------------------------------------------------- motion
+    def _move(self, distance: float, yaw: float) -> bool:
+        """Translate along ``yaw`` by ``distance`` m; returns True when blocked."""
+        if distance == 0.0:
+            return False
+        n = max(1, math.ceil(abs(distance) / (self.house.nav.resolution / 2.0)))
+        d = np.array([math.cos(yaw), math.sin(yaw)]) * (distance / n)
+        xy = self.pose.xy
+        moved = 0
+        for _ in range(n):
+            nxt = xy + d
+            if not self.is_free(nxt):
+                break
+            xy = nxt
+            moved += 1
+        self.path_length += abs(distance) * moved / n
+        self.pose = Pose2D(float(xy[0]), float(xy[1]), self.pose.yaw)
+        return moved < n
+
+    def step(self, action: DiscreteAction) -> Frame:
+        """Apply one discrete action (Habitat semantics) and return the new observation."""
+        c = self.config
+        self.collided = False
+        if action == DiscreteAction.MOVE_FORWARD:
+            self.collided = self._move(c.forward_step, self.pose.yaw)
+        elif action == DiscreteAction.TURN_LEFT:
+            self.pose = Pose2D(self.pose.x, self.pose.y,
+                               wrap_angle(self.pose.yaw + math.radians(c.turn_deg)))
+        elif action == DiscreteAction.TURN_RIGHT:
+            self.pose = Pose2D(self.pose.x, self.pose.y,
+                               wrap_angle(self.pose.yaw - math.radians(c.turn_deg)))
+        elif action == DiscreteAction.LOOK_UP:
+            self.tilt = min(self.tilt + math.radians(c.tilt_deg), math.radians(c.max_tilt_deg))
+        elif action == DiscreteAction.LOOK_DOWN:
+            self.tilt = max(self.tilt - math.radians(c.tilt_deg), -math.radians(c.max_tilt_deg))
+        elif action == DiscreteAction.STOP:
+            self.stopped = True
+        else:
+            raise SimulatorError(f"unknown action {action!r}", field="action")
+        self.collisions += int(self.collided)
+        self.steps += 1
+        self.time += ACTION_SECONDS
+        return self.observe()
+
+    def step_velocity(self, cmd: VelocityCommand, dt: float) -> Frame:
+        """Integrate a body-frame velocity (unicycle) for ``dt`` s, with collisions."""
+        if not dt > 0.0:
+            raise SimulatorError(f"dt must be > 0, got {dt}", field="dt")
+        n = max(1, math.ceil(abs(cmd.v) * dt / (self.house.nav.resolution / 2.0)))
+        h = dt / n
+        self.collided = False
+        for _ in range(n):
+            yaw_mid = self.pose.yaw + 0.5 * cmd.omega * h
+            blocked = self._move(cmd.v * h, yaw_mid)
+            self.pose = Pose2D(self.pose.x, self.pose.y, wrap_angle(self.pose.yaw + cmd.omega * h))
+            if blocked:
+                self.collided = True
+        self.collisions += int(self.collided)
+        self.steps += 1
+        self.time += dt
+        return self.observe()
+
+    # ----------------------------------------------------------------------------- sensing
+    @property
+    def renderer(self):
+        """The renderer of the calling thread (re-created if the simulator changed threads)."""
+        if self._renderer is not None and self._renderer.thread != threading.get_ident():
+            self._renderer = None  # its GL objects belong to the other thread's context
+        if self._renderer is None:
+            from hiconav.sim.renderer import Renderer
+
+            c = self.config
+            self._renderer = Renderer(c.width, c.height, min_depth=c.min_depth,
+                                      max_depth=c.max_depth, noise=c.texture_noise)
+            self._renderer.set_house(self.house)
+        return self._renderer
+
+    @property
+    def T_world_cam(self) -> np.ndarray:
+        return camera_pose_from_base(self.pose, self.config.camera_height, self.tilt)
+
+    def observe(self) -> Frame:
+        """Render the current view (no state change besides the frame counter)."""
+        T = self.T_world_cam
+        rgb, depth, instances = self.renderer.render(T, self.intrinsics)
+        self._seq += 1
+        return Frame(rgb=rgb, depth=depth, intrinsics=self.intrinsics, T_world_cam=T,
+                     base_pose=self.pose, stamp=self.time, instances=instances, seq=self._seq)
+
+    def close(self) -> None:
+        """Free the renderer's GL objects (only possible from the thread that made them)."""
+        if self._renderer is not None and self._renderer.thread == threading.get_ident():
+            self._renderer.release()
+        self._renderer = None

@@ -1,0 +1,97 @@
+"""Geodesic distances agree with an independent Dijkstra (heapq) and with geometry."""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numpy as np
+import pytest
+from sim_synthetic import box_room, obj
+
+from hiconav.sim.geodesic import GoalDistance, GridGraph, clearance, traversable
+from hiconav.sim.house import Wall
+
+
+def _heap_dijkstra(mask, sources, offsets, res):
+    """Reference: 8-connected, no corner cutting, initial values = offsets."""
+    h, w = mask.shape
+    dist = np.full((h, w), np.inf)
+    heap = []
+    for (r, c), o in zip(sources, offsets):
+        if o < dist[r, c]:
+            dist[r, c] = o
+            heapq.heappush(heap, (o, r, c))
+    while heap:
+        d, r, c = heapq.heappop(heap)
+        if d > dist[r, c]:
+            continue
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                if not (dr or dc):
+                    continue
+                rr, cc = r + dr, c + dc
+                if not (0 <= rr < h and 0 <= cc < w and mask[rr, cc]):
+                    continue
+                if dr and dc and not (mask[r + dr, c] and mask[r, c + dc]):
+                    continue
+                nd = d + res * (math.sqrt(2) if dr and dc else 1.0)
+                if nd < dist[rr, cc]:
+                    dist[rr, cc] = nd
+                    heapq.heappush(heap, (nd, rr, cc))
+    return dist
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_scipy_dijkstra_matches_a_heap_reimplementation(seed):
+    rng = np.random.default_rng(seed)
+    mask = rng.random((40, 55)) > 0.25
+    free = np.argwhere(mask)
+    k = rng.choice(len(free), size=4, replace=False)
+    sources = free[k]
+    offsets = rng.uniform(0.0, 0.2, size=4)
+    got = GridGraph(mask, 0.05).multi_source(sources, offsets)
+    ref = _heap_dijkstra(mask, sources, offsets, 0.05)
+    assert np.array_equal(np.isfinite(got), np.isfinite(ref))
+    fin = np.isfinite(ref)
+    np.testing.assert_allclose(got[fin], ref[fin], atol=1e-6)
+
+
+def test_goal_distance_in_open_space_is_straight_line_to_the_footprint():
+    house = box_room(8.0, [obj(0, "chair", (6.0, 4.0, 0.45), (0.5, 0.5, 0.9))])
+    gd = GoalDistance(house, instance_ids=[0])
+    # Same row as the chair: distance to its near face (x = 5.75), within a cell.
+    for x in (1.0, 2.5, 4.0):
+        assert gd.distance(np.array([x, 4.0])) == pytest.approx(5.75 - x, abs=0.06)
+
+
+def test_goal_distance_goes_around_a_wall():
+    wall = Wall((4.0, 0.0), (4.0, 6.0), 2.5, 0.1)  # open only for y in (6, 8)
+    house = box_room(8.0, [obj(0, "bed", (6.0, 2.0, 0.3), (1.0, 1.0, 0.6))], [wall])
+    gd = GoalDistance(house, instance_ids=[0])
+    start = np.array([2.0, 2.0])
+    d = gd.distance(start)
+    # Lower bound: via the gap corner (4, 6 + radius) to the bed's nearest corner (5.5, 2.5).
+    corner = np.array([4.0, 6.05 + 0.18])
+    lower = np.linalg.norm(corner - start) + np.linalg.norm(np.array([5.5, 2.5]) - corner)
+    assert d >= lower - 0.1
+    assert d <= lower * 1.1 + 0.2
+    assert d > 2 * (5.5 - 2.0)  # far longer than the straight line
+
+
+def test_traversable_respects_robot_radius():
+    house = box_room(4.0)
+    free = traversable(house.nav, 0.18)
+    cl = clearance(house.nav)
+    assert np.all(cl[free] >= 0.18 - 1e-9)
+    # A cell next to the wall face (x = 0.05 .. 0.10) is navigable but not traversable.
+    rc = house.nav.world_to_cell(np.array([0.12, 2.0]))
+    assert house.nav.navigable[rc[0], rc[1]] and not free[rc[0], rc[1]]
+
+
+def test_unreachable_goal_is_infinite():
+    wall = Wall((4.0, 0.0), (4.0, 8.0), 2.5, 0.1)
+    house = box_room(8.0, [obj(0, "toilet", (6.0, 2.0, 0.4), (0.5, 0.5, 0.8))], [wall])
+    gd = GoalDistance(house, instance_ids=[0])
+    assert math.isinf(gd.distance(np.array([2.0, 2.0])))
+    assert math.isfinite(gd.distance(np.array([6.0, 5.0])))

@@ -1,0 +1,68 @@
+"""ObjectNav metrics on hand-made cases."""
+
+from __future__ import annotations
+
+import pytest
+
+from hiconav.sim.config import SimConfig
+from hiconav.sim.episodes import Episode
+from hiconav.sim.metrics import dts, episode_metrics, spl
+from hiconav.types import Pose2D
+
+EP = Episode("e1", "h", Pose2D(0, 0, 0), "bed", (3,), 4.0, "find the bed")
+
+
+def test_spl_cases():
+    assert spl(True, 4.0, 4.0) == 1.0
+    assert spl(True, 4.0, 8.0) == 0.5
+    assert spl(True, 4.0, 2.0) == 1.0  # a path shorter than the geodesic counts as optimal
+    assert spl(False, 4.0, 4.0) == 0.0
+    assert spl(True, 0.0, 0.0) == 1.0
+
+
+def test_dts_cases():
+    assert dts(3.5, 1.0) == 2.5
+    assert dts(0.4, 1.0) == 0.0
+
+
+def test_success_needs_stop_within_distance_and_steps():
+    ok = episode_metrics(EP, final_distance=0.9, path_length=5.0, steps=40, stopped=True)
+    assert ok.success and ok.spl == pytest.approx(0.8) and ok.dts == 0.0
+    no_stop = episode_metrics(EP, final_distance=0.9, path_length=5.0, steps=500, stopped=False)
+    assert not no_stop.success and no_stop.spl == 0.0
+    far = episode_metrics(EP, final_distance=1.2, path_length=5.0, steps=40, stopped=True)
+    assert not far.success and far.dts == pytest.approx(0.2)
+    late = episode_metrics(EP, final_distance=0.5, path_length=5.0, steps=501, stopped=True)
+    assert not late.success
+    cfg = SimConfig(success_distance=1.5)
+    assert episode_metrics(EP, final_distance=1.2, path_length=5.0, steps=40, stopped=True,
+                           config=cfg).success
+    assert ok.to_json()["episode_id"] == "e1"
+
+
+def test_tracker_scores_a_simulated_episode():
+    import numpy as np
+    from sim_synthetic import box_room, obj
+
+    from hiconav.sim.episodes import generate_episodes
+    from hiconav.sim.geodesic import GoalDistance
+    from hiconav.sim.metrics import EpisodeTracker
+    from hiconav.sim.simulator import Simulator
+    from hiconav.types import DiscreteAction
+
+    house = box_room(8.0, [obj(0, "bed", (6.5, 4.0, 0.3), (1.0, 2.0, 0.6))])
+    ep = generate_episodes(house, 1, seed=0)[0]
+    sim = Simulator(house)
+    sim.observe = lambda: None
+    sim.reset(Pose2D(2.0, 4.0, 0.0))
+    ep = Episode("t", house.name, Pose2D(2.0, 4.0, 0.0), "bed", (0,),
+                 GoalDistance(house, ep).distance(np.array([2.0, 4.0])), "find the bed")
+    tracker = EpisodeTracker(sim, ep)
+    for _ in range(13):  # 3.25 m towards the bed's face at x = 6.0: ends 0.75 m from it
+        sim.step(DiscreteAction.MOVE_FORWARD)
+    sim.step(DiscreteAction.STOP)
+    m = tracker.finish()
+    assert tracker.done and m.stopped and m.success
+    assert m.path_length == pytest.approx(3.25)
+    assert m.final_distance == pytest.approx(0.75, abs=0.06)
+    assert m.spl == pytest.approx(min(ep.geodesic_distance / 3.25, 1.0))
