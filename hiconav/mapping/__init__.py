@@ -1,0 +1,19 @@
+"""Mapping: the occupancy grid built from depth (free / occupied / unknown, inflation) and frontiers."""
+
+from hiconav.mapping.config import FrontierConfig, MappingConfig, OccupancyConfig
+from hiconav.mapping.frontiers import FrontierTracker, frontier_mask
+from hiconav.mapping.occupancy import FREE, OCCUPIED, UNKNOWN, GridSnapshot, IntegrationStats, OccupancyGrid
+
+__all__ = [
+    "FREE",
+    "OCCUPIED",
+    "UNKNOWN",
+    "FrontierConfig",
+    "FrontierTracker",
+    "GridSnapshot",
+    "IntegrationStats",
+    "MappingConfig",
+    "OccupancyConfig",
+    "OccupancyGrid",
+    "frontier_mask",
+]

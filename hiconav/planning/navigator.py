@@ -1,0 +1,353 @@
+"""The Navigator: A* to the current goal on the inflated grid, path following, re-planning, recovery.
+
+One call per control tick: ``step`` returns a Habitat-style DiscreteAction, ``step_velocity`` a
+VelocityCommand. It plans locally and cheaply (A* in a window around start and goal first, the
+whole grid only when the window has no path), re-plans when the path becomes blocked, when the
+robot strays from it, or every ``replan_every`` ticks, and recovers when stuck (a virtual
+obstacle where the robot could not move, then rotate toward the more open side, and in
+velocity mode back off first).
+
+It must not choose goals (exploration and the mission do) and must not modify the grid it is
+given; STOP from ``step`` means "nothing to do": check ``reached`` and ``status``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Protocol
+
+import cv2
+import numpy as np
+
+from hiconav.geometry import ray_cast_grid
+from hiconav.mapping.frontiers import nearest_reachable_cell
+from hiconav.planning.astar import astar, smooth_path
+from hiconav.planning.config import NavigatorConfig
+from hiconav.planning.discrete import heading_action, to_discrete
+from hiconav.planning.local_planner import PurePursuit, segment_target
+from hiconav.types import DiscreteAction, Goal, Pose2D, VelocityCommand, wrap_angle
+
+__all__ = ["Navigator", "blocked_cells", "plan_path"]
+
+log = logging.getLogger(__name__)
+
+
+class _Grid(Protocol):
+    state: np.ndarray
+    inflated: np.ndarray
+    origin: np.ndarray
+    resolution: float
+
+    def world_to_cell(self, xy: np.ndarray) -> np.ndarray: ...
+    def cell_to_world(self, rc: np.ndarray) -> np.ndarray: ...
+
+
+def blocked_cells(grid: _Grid, *, through_unknown: bool = False) -> np.ndarray:
+    """(H, W) bool cells the robot centre must not enter: inflated obstacles (+ unknown cells)."""
+    blocked = np.array(grid.inflated, dtype=bool, copy=True)
+    if not through_unknown:
+        blocked |= grid.state == -1
+    return blocked
+
+
+def _disk(blocked: np.ndarray, rc: np.ndarray, radius_cells: float) -> tuple[slice, slice, np.ndarray]:
+    h, w = blocked.shape
+    r = int(math.ceil(radius_cells))
+    r0, r1 = max(0, rc[0] - r), min(h, rc[0] + r + 1)
+    c0, c1 = max(0, rc[1] - r), min(w, rc[1] + r + 1)
+    yy, xx = np.mgrid[r0:r1, c0:c1]
+    m = (yy - rc[0]) ** 2 + (xx - rc[1]) ** 2 <= radius_cells**2
+    return slice(r0, r1), slice(c0, c1), m
+
+
+def plan_path(
+    blocked: np.ndarray, start: tuple[int, int], goal: tuple[int, int], margin_cells: int
+) -> np.ndarray | None:
+    """A* in the start-goal bounding box grown by ``margin_cells``; the full grid if that fails.
+
+    Returns (N, 2) int64 cells in ``blocked``'s indexing, or None.
+    """
+    h, w = blocked.shape
+    r0 = max(0, min(start[0], goal[0]) - margin_cells)
+    r1 = min(h, max(start[0], goal[0]) + margin_cells + 1)
+    c0 = max(0, min(start[1], goal[1]) - margin_cells)
+    c1 = min(w, max(start[1], goal[1]) + margin_cells + 1)
+    if (r1 - r0) * (c1 - c0) < h * w:
+        sub = astar(blocked[r0:r1, c0:c1], (start[0] - r0, start[1] - c0), (goal[0] - r0, goal[1] - c0))
+        if sub is not None:
+            return sub + np.array([r0, c0])
+    return astar(blocked, start, goal)
+
+
+class Navigator:
+    """Follows A* paths to a Goal on an occupancy grid (OccupancyGrid or GridSnapshot).
+
+    Attributes: goal (Goal | None), reached (bool), status ("idle", "following", "reached",
+    "no_path", "recovering"), path_xy ((N, 2) world waypoints of the smoothed path or None),
+    n_plans, n_recoveries.
+    """
+
+    def __init__(self, config: NavigatorConfig | None = None) -> None:
+        self.config = config or NavigatorConfig()
+        self.local = PurePursuit(self.config.local)
+        self.goal: Goal | None = None
+        self.reached = False
+        self.status = "idle"
+        self.path_xy: np.ndarray | None = None
+        self._dense_xy: np.ndarray | None = None  # A* cell centres (world), for blockage checks
+        self._ticks_since_plan = 0
+        self._virtual: list[tuple[float, float, float]] = []  # (x, y, radius) where the robot got stuck
+        self._last_pose: Pose2D | None = None
+        self._last_action: DiscreteAction | None = None
+        self._stuck = 0
+        self._recovery: list[DiscreteAction] = []
+        self._vel_recovery: list[tuple[float, float, float]] = []  # (v, omega, seconds)
+        self._progress_ref: tuple[float, float, float] | None = None  # (x, y, elapsed)
+        self._elapsed = 0.0
+        self.n_plans = 0
+        self.n_recoveries = 0
+
+    # ------------------------------------------------------------------ goal
+    def set_goal(self, goal: Goal | None) -> None:
+        """Start navigating to ``goal`` (None: stop). Keeps learned virtual obstacles.
+
+        Setting the goal already being followed (an equal Goal) changes nothing, so callers may
+        re-send it every tick without interrupting a recovery or resetting ``reached``.
+        """
+        if goal is not None and goal == self.goal:
+            return
+        self.goal = goal
+        self.reached = False
+        self.status = "idle" if goal is None else "following"
+        self.path_xy = None
+        self._dense_xy = None
+        self._recovery.clear()
+        self._vel_recovery.clear()
+        self._stuck = 0
+        self._progress_ref = None
+        self.local.reset()
+
+    def clear_virtual_obstacles(self) -> None:
+        self._virtual.clear()
+
+    # ------------------------------------------------------------------ planning
+    def _blocked(self, grid: _Grid, start_rc: np.ndarray) -> np.ndarray:
+        cfg = self.config
+        blocked = blocked_cells(grid, through_unknown=cfg.plan_through_unknown)
+        res = grid.resolution
+        for x, y, r in self._virtual:
+            rc = grid.world_to_cell(np.array([x, y]))
+            rs, cs, m = _disk(blocked, rc, r / res)
+            blocked[rs, cs] |= m
+        # the robot may stand inside the inflation zone: let it leave it, but only through cells
+        # farther from the obstacles than the robot itself (never along or toward a wall)
+        h, w = blocked.shape
+        sr, sc = int(start_rc[0]), int(start_rc[1])
+        if 0 <= sr < h and 0 <= sc < w and blocked[sr, sc]:
+            rs, cs, m = _disk(blocked, start_rc, 0.3 / res)
+            free = (grid.state[rs, cs] != 1).astype(np.uint8)
+            clearance = cv2.distanceTransform(free, cv2.DIST_L2, 5)
+            here = clearance[sr - rs.start, sc - cs.start]
+            sub = blocked[rs, cs]
+            sub[m & (clearance > here + 0.5) & (free > 0)] = False  # strictly away from obstacles
+        return blocked
+
+    def plan(self, grid: _Grid, pose: Pose2D) -> bool:
+        """Plan from ``pose`` to the goal; sets ``path_xy``. False (status "no_path") if none."""
+        self._ticks_since_plan = 0
+        self.n_plans += 1
+        if self.goal is None:
+            return False
+        res = grid.resolution
+        h, w = grid.state.shape
+        start = grid.world_to_cell(pose.xy)
+        goal = grid.world_to_cell(self.goal.xy)
+        if not (0 <= start[0] < h and 0 <= start[1] < w) or not (0 <= goal[0] < h and 0 <= goal[1] < w):
+            self.path_xy, self._dense_xy, self.status = None, None, "no_path"
+            return False
+        blocked = self._blocked(grid, start)
+        g = (int(goal[0]), int(goal[1]))
+        if blocked[g]:
+            snapped = nearest_reachable_cell(~blocked, g, int(math.ceil(self.config.goal_snap_m / res)))
+            if snapped is None:
+                self.path_xy, self._dense_xy, self.status = None, None, "no_path"
+                return False
+            g = snapped
+        cells = plan_path(
+            blocked, (int(start[0]), int(start[1])), g, int(math.ceil(self.config.window_margin_m / res))
+        )
+        if cells is None:
+            self.path_xy, self._dense_xy, self.status = None, None, "no_path"
+            return False
+        way = smooth_path(blocked, cells)
+        path = grid.cell_to_world(way)
+        path[0] = pose.xy
+        self.path_xy = path
+        self._dense_xy = grid.cell_to_world(cells[1:]) if len(cells) > 1 else grid.cell_to_world(cells)
+        self.status = "following"
+        return True
+
+    def _path_blocked(self, grid: _Grid, pose: Pose2D) -> bool:
+        """True if a remaining cell of the current path is now blocked (escape rule included)."""
+        if self._dense_xy is None:
+            return True
+        rc = grid.world_to_cell(self._dense_xy)
+        h, w = grid.state.shape
+        ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
+        if not ok.all():
+            return True
+        # only the part of the path still ahead of the robot
+        k = int(np.argmin(np.hypot(*(self._dense_xy - pose.xy).T)))
+        rc = rc[k:]
+        blocked = self._blocked(grid, grid.world_to_cell(pose.xy))
+        return bool(blocked[rc[:, 0], rc[:, 1]].any())
+
+    def _need_replan(self, grid: _Grid, pose: Pose2D) -> bool:
+        if self.path_xy is None or self._ticks_since_plan >= self.config.replan_every:
+            return True
+        if self._path_blocked(grid, pose):
+            return True
+        d = self._dense_xy if self._dense_xy is not None and len(self._dense_xy) else self.path_xy
+        return float(np.min(np.hypot(*(d - pose.xy).T))) > self.config.deviation_m
+
+    def _goal_reached(self, pose: Pose2D) -> bool:
+        assert self.goal is not None
+        if pose.distance_to(Pose2D(self.goal.x, self.goal.y, 0.0)) <= self.goal.tolerance:
+            return True
+        # the goal itself may be blocked: reaching the end of the snapped path counts
+        if self.path_xy is not None and len(self.path_xy) >= 1:
+            end = self.path_xy[-1]
+            return bool(
+                np.hypot(*(end - pose.xy)) <= 0.5 * self.config.discrete.forward_step_m + 1e-6
+                and np.hypot(*(end - self.goal.xy)) <= self.config.goal_snap_m
+            )
+        return False
+
+    def _open_side(self, grid: _Grid, pose: Pose2D) -> int:
+        """+1 if the left (CCW) side is more open than the right, else -1 (ray casting)."""
+        blocked = blocked_cells(grid, through_unknown=True)
+        rc = grid.world_to_cell(pose.xy) + 0.5
+        angles = pose.yaw + np.array([math.pi / 2, math.pi / 3, -math.pi / 2, -math.pi / 3])
+        d = ray_cast_grid(blocked, (float(rc[0]), float(rc[1])), angles, 2.0 / grid.resolution)
+        return 1 if d[:2].sum() >= d[2:].sum() else -1
+
+    def _add_virtual_obstacle(self, pose: Pose2D) -> None:
+        r = self.config.virtual_obstacle_m
+        if r <= 0:
+            return
+        ahead = 0.18 + r
+        self._virtual.append((pose.x + ahead * math.cos(pose.yaw), pose.y + ahead * math.sin(pose.yaw), r))
+
+    # ------------------------------------------------------------------ discrete control
+    def step(self, grid: _Grid, pose: Pose2D) -> DiscreteAction:
+        """The next discrete action toward the goal (STOP when reached or when there is no path)."""
+        cfg = self.config
+        self._ticks_since_plan += 1
+        if self.goal is None:
+            self.status = "idle"
+            return self._act(DiscreteAction.STOP, pose)
+        # stuck detection: a forward step that did not move the robot
+        if self._last_action == DiscreteAction.MOVE_FORWARD and self._last_pose is not None:
+            if self._last_pose.distance_to(pose) < cfg.stuck_progress_m:
+                self._stuck += 1
+                self._add_virtual_obstacle(pose)
+                self.path_xy = None  # force a re-plan around the new obstacle
+                if self._stuck >= cfg.stuck_limit and not self._recovery:
+                    side = self._open_side(grid, pose)
+                    turn = DiscreteAction.TURN_LEFT if side > 0 else DiscreteAction.TURN_RIGHT
+                    self._recovery = [turn] * cfg.recovery_turns + [DiscreteAction.MOVE_FORWARD]
+                    self.n_recoveries += 1
+                    self._stuck = 0
+                    log.info("navigator stuck at (%.2f, %.2f): recovery %s", pose.x, pose.y, turn.value)
+            else:
+                self._stuck = 0
+        if self._recovery:
+            self.status = "recovering"
+            action = self._recovery.pop(0)
+            if not self._recovery:
+                self.path_xy = None
+            return self._act(action, pose)
+        if self._goal_reached(pose):
+            if self.goal.yaw is not None:
+                turn = heading_action(pose, self.goal.yaw, cfg.discrete.turn_tolerance_deg)
+                if turn is not None:
+                    return self._act(turn, pose)
+            self.reached = True
+            self.status = "reached"
+            return self._act(DiscreteAction.STOP, pose)
+        if self._need_replan(grid, pose) and not self.plan(grid, pose):
+            return self._act(DiscreteAction.STOP, pose)
+        assert self.path_xy is not None
+        target = segment_target(
+            self.path_xy, pose.xy, cfg.discrete.lookahead_m, switch=0.5 * cfg.discrete.forward_step_m
+        )
+        if np.hypot(*(target - pose.xy)) < 1e-6:
+            target = self.path_xy[-1]
+        return self._act(to_discrete(pose, target, cfg.discrete.turn_tolerance_deg), pose)
+
+    def _act(self, action: DiscreteAction, pose: Pose2D) -> DiscreteAction:
+        self._last_action = action
+        self._last_pose = pose
+        return action
+
+    # ------------------------------------------------------------------ velocity control
+    def step_velocity(
+        self, grid: _Grid, pose: Pose2D, dt: float = 0.1, stamp: float = 0.0
+    ) -> VelocityCommand:
+        """The next velocity command toward the goal (zero when reached or when there is no path)."""
+        cfg = self.config
+        self._ticks_since_plan += 1
+        self._elapsed += dt
+        if self.goal is None:
+            self.status = "idle"
+            return VelocityCommand.zero(stamp)
+        if self._vel_recovery:
+            self.status = "recovering"
+            v, om, left = self._vel_recovery[0]
+            left -= dt
+            if left <= 0:
+                self._vel_recovery.pop(0)
+                if not self._vel_recovery:
+                    self.path_xy = None
+                    self._progress_ref = None
+            else:
+                self._vel_recovery[0] = (v, om, left)
+            return VelocityCommand(v, om, stamp)
+        if self._goal_reached(pose):
+            if self.goal.yaw is not None:
+                err = wrap_angle(self.goal.yaw - pose.yaw)
+                if abs(err) > math.radians(cfg.discrete.turn_tolerance_deg):
+                    om = float(
+                        np.clip(cfg.local.heading_gain * err, -cfg.local.omega_max, cfg.local.omega_max)
+                    )
+                    return VelocityCommand(0.0, om, stamp)
+            self.reached = True
+            self.status = "reached"
+            self.local.reset()
+            return VelocityCommand.zero(stamp)
+        # stuck detection: no progress over stuck_time_s while trying to move
+        if self._progress_ref is None:
+            self._progress_ref = (pose.x, pose.y, self._elapsed)
+        elif self._elapsed - self._progress_ref[2] >= cfg.stuck_time_s:
+            moved = math.hypot(pose.x - self._progress_ref[0], pose.y - self._progress_ref[1])
+            if moved < cfg.stuck_progress_m * 2:
+                self._add_virtual_obstacle(pose)
+                side = self._open_side(grid, pose)
+                self._vel_recovery = [
+                    (-cfg.back_off_speed, 0.0, cfg.back_off_s),
+                    (0.0, side * cfg.local.omega_max, (math.pi / 2) / cfg.local.omega_max),
+                ]
+                self.n_recoveries += 1
+                self.local.reset()
+                log.info("navigator stuck at (%.2f, %.2f): backing off and rotating", pose.x, pose.y)
+                return self.step_velocity(grid, pose, 0.0, stamp)
+            self._progress_ref = (pose.x, pose.y, self._elapsed)
+        if self._need_replan(grid, pose) and not self.plan(grid, pose):
+            self.local.reset()
+            return VelocityCommand.zero(stamp)
+        assert self.path_xy is not None
+        cmd = self.local.command(pose, self.path_xy, dt, stamp)
+        if cmd.v < 0.05:  # turning on the spot is not being stuck
+            self._progress_ref = None
+        return cmd

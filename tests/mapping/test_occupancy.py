@@ -1,0 +1,218 @@
+"""hiconav.mapping.OccupancyGrid: free / occupied / unknown from depth, inflation, growth, bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hiconav.errors import FrameError
+from hiconav.geometry import pixel_rays
+from hiconav.mapping import FREE, OCCUPIED, UNKNOWN, OccupancyConfig, OccupancyGrid
+from hiconav.types import CameraIntrinsics, Frame, Pose2D, camera_pose_from_base
+
+K = CameraIntrinsics.from_hfov(160, 120, 79.0)
+
+
+def render_boxes(
+    pose: Pose2D, boxes: list[tuple[tuple, tuple]], max_depth: float = 5.0, K: CameraIntrinsics = K
+) -> Frame:
+    """Analytic depth of a floor (z = 0) and axis-aligned boxes (min xyz, max xyz); 0 beyond max_depth."""
+    T = camera_pose_from_base(pose, 0.88)
+    xr, yr = pixel_rays(K)
+    rays = np.stack([xr, yr, np.ones_like(xr)], -1).astype(np.float64) @ T[:3, :3].T  # z_cam = 1
+    o = T[:3, 3]
+    t = np.full(xr.shape, np.inf)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tf = np.where(rays[..., 2] < 0, -o[2] / rays[..., 2], np.inf)
+        t = np.minimum(t, tf)
+        for lo, hi in boxes:
+            lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+            t1 = (lo - o) / rays
+            t2 = (hi - o) / rays
+            tmin = np.nanmax(np.minimum(t1, t2), axis=-1)
+            tmax = np.nanmin(np.maximum(t1, t2), axis=-1)
+            hit = (tmax >= tmin) & (tmax > 0)
+            t = np.where(hit, np.minimum(t, np.maximum(tmin, 0)), t)
+    depth = np.where(t <= max_depth, t, 0.0).astype(np.float32)
+    return Frame(
+        rgb=np.zeros(xr.shape + (3,), np.uint8),
+        depth=depth,
+        intrinsics=K,
+        T_world_cam=T,
+        base_pose=pose,
+        stamp=0.0,
+    )
+
+
+WALL = ((3.02, -2.0, 0.0), (3.2, 2.0, 2.0))  # a wall 3 m ahead of the origin, facing -x
+
+
+def cell_state(grid: OccupancyGrid, x: float, y: float) -> int:
+    r, c = grid.world_to_cell(np.array([x, y]))
+    return int(grid.state[r, c])
+
+
+def test_wall_ahead_is_occupied_and_floor_before_it_is_free():
+    grid = OccupancyGrid(OccupancyConfig(depth_stride=1))
+    stats = grid.integrate(render_boxes(Pose2D(0, 0, 0), [WALL]))
+    assert stats.n_obstacle_points > 0
+    assert cell_state(grid, 3.03, 0.0) == OCCUPIED
+    for x in (0.5, 1.5, 2.5, 2.85):
+        assert cell_state(grid, x, 0.0) == FREE, x
+    assert cell_state(grid, 3.6, 0.0) == UNKNOWN  # behind the wall
+    assert cell_state(grid, -1.0, 0.0) == UNKNOWN  # behind the robot
+    assert cell_state(grid, 1.0, 3.0) == UNKNOWN  # outside the field of view
+    r, c = grid.world_to_cell(np.array([2.9, 0.0]))
+    assert grid.inflated[r, c]  # within the robot radius of the wall
+    r, c = grid.world_to_cell(np.array([2.5, 0.0]))
+    assert not grid.inflated[r, c]
+    assert grid.explored[grid.state != UNKNOWN].all() and grid.explored_area_m2 > 2.0
+
+
+def test_height_band_ignores_low_and_high_things():
+    low = ((1.5, -0.3, 0.0), (1.8, 0.3, 0.05))  # a 5 cm rug-like slab: traversable
+    high = ((1.5, 0.6, 1.7), (1.8, 1.2, 2.0))  # a shelf above the robot
+    grid = OccupancyGrid(OccupancyConfig(depth_stride=1))
+    grid.integrate(render_boxes(Pose2D(0, 0, 0), [low, high, WALL]))
+    assert cell_state(grid, 1.65, 0.0) == FREE
+    assert cell_state(grid, 1.65, 0.9) != OCCUPIED
+
+
+def test_box_on_the_floor_is_an_obstacle_with_unknown_shadow():
+    box = ((2.02, -0.3, 0.0), (2.4, 0.3, 0.6))
+    grid = OccupancyGrid(OccupancyConfig(depth_stride=2))
+    grid.integrate(render_boxes(Pose2D(0, 0, 0), [box, WALL]))
+    assert cell_state(grid, 2.03, 0.0) == OCCUPIED
+    assert cell_state(grid, 2.8, 0.0) == UNKNOWN  # hidden behind the box
+    assert cell_state(grid, 1.5, 0.0) == FREE
+
+
+def test_nan_inf_zero_negative_depth_never_corrupts_the_map():
+    frame = render_boxes(Pose2D(0, 0, 0), [WALL])
+    clean = OccupancyGrid(OccupancyConfig(depth_stride=1))
+    clean.integrate(frame)
+    bad_depth = np.array(frame.depth, copy=True)
+    rng = np.random.default_rng(0)
+    idx = rng.random(bad_depth.shape) < 0.2
+    bad_depth[idx] = rng.choice(np.array([np.nan, np.inf, 0.0, -3.0], np.float32), size=int(idx.sum()))
+    noisy = OccupancyGrid(OccupancyConfig(depth_stride=1))
+    stats = noisy.integrate(
+        Frame(
+            rgb=frame.rgb,
+            depth=bad_depth,
+            intrinsics=K,
+            T_world_cam=frame.T_world_cam,
+            base_pose=frame.base_pose,
+            stamp=0.0,
+        )
+    )
+    assert stats.n_invalid >= int(idx.sum())
+    assert noisy.n_invalid_total == stats.n_invalid
+    # nothing becomes free or occupied that the clean frame did not make so
+    assert not np.any((noisy.state == FREE) & (clean.state != FREE))
+    assert not np.any((noisy.state == OCCUPIED) & (clean.state != OCCUPIED))
+    assert cell_state(noisy, 3.03, 0.0) == OCCUPIED
+
+
+def test_all_invalid_frame_changes_nothing_but_the_footprint():
+    frame = render_boxes(Pose2D(0, 0, 0), [WALL])
+    grid = OccupancyGrid()
+    grid.integrate(frame)
+    before = grid.state.copy()
+    nan = np.full_like(np.asarray(frame.depth), np.nan)
+    grid.integrate(
+        Frame(
+            rgb=frame.rgb,
+            depth=nan,
+            intrinsics=K,
+            T_world_cam=frame.T_world_cam,
+            base_pose=frame.base_pose,
+            stamp=1.0,
+        )
+    )
+    np.testing.assert_array_equal(grid.state, before)
+
+
+@pytest.mark.parametrize("case", ["shape", "pose", "base_pose", "nonfinite"])
+def test_bad_frames_are_rejected_and_leave_the_map_untouched(case):
+    frame = render_boxes(Pose2D(0, 0, 0), [WALL])
+    grid = OccupancyGrid()
+    grid.integrate(frame)
+    before = (grid.state.copy(), grid.origin.copy(), grid.version)
+    kwargs = dict(
+        rgb=frame.rgb,
+        depth=frame.depth,
+        intrinsics=K,
+        T_world_cam=frame.T_world_cam,
+        base_pose=frame.base_pose,
+        stamp=1.0,
+    )
+    if case == "shape":
+        kwargs["depth"] = np.ones((120, 100), np.float32)
+    elif case == "pose":
+        kwargs["T_world_cam"] = None
+    elif case == "base_pose":
+        kwargs["base_pose"] = None
+    else:
+        kwargs["base_pose"] = Pose2D(float("nan"), 0.0, 0.0)
+    with pytest.raises(FrameError):
+        grid.integrate(Frame(**kwargs))
+    np.testing.assert_array_equal(grid.state, before[0])
+    np.testing.assert_array_equal(grid.origin, before[1])
+    assert grid.version == before[2]
+
+
+def test_grid_grows_and_keeps_what_it_knew():
+    grid = OccupancyGrid(OccupancyConfig(initial_size_m=4.0, grow_padding_m=1.0))
+    grid.integrate(render_boxes(Pose2D(0, 0, 0), [WALL]))
+    shape0 = grid.shape
+    assert cell_state(grid, 3.03, 0.0) == OCCUPIED
+    far_wall = ((20.02, -2.0, 0.0), (20.2, 2.0, 2.0))
+    stats = grid.integrate(render_boxes(Pose2D(17.0, 0.0, 0.0), [far_wall]))
+    assert stats.grew and grid.shape[1] > shape0[1]
+    assert cell_state(grid, 3.03, 0.0) == OCCUPIED  # old knowledge moved with the origin
+    assert cell_state(grid, 20.03, 0.0) == OCCUPIED
+    # the origin stays on the global lattice of cells
+    assert np.allclose(grid.origin / grid.resolution, np.round(grid.origin / grid.resolution))
+
+
+def test_world_cell_round_trip_and_snapshot_is_read_only():
+    grid = OccupancyGrid()
+    grid.integrate(render_boxes(Pose2D(0.3, -0.2, 0.5), [WALL]))
+    rc = np.array([[10, 20], [5, 7]])
+    np.testing.assert_array_equal(grid.world_to_cell(grid.cell_to_world(rc)), rc)
+    snap = grid.snapshot()
+    assert not snap.state.flags.writeable and not snap.inflated.flags.writeable
+    np.testing.assert_array_equal(snap.state, grid.state)
+    np.testing.assert_array_equal(
+        snap.world_to_cell(np.array([1.0, 2.0])), grid.world_to_cell(np.array([1.0, 2.0]))
+    )
+    assert snap.version == grid.version == 1
+
+
+def test_robot_footprint_is_free():
+    grid = OccupancyGrid()
+    grid.integrate(render_boxes(Pose2D(0.0, 0.0, 0.0), [WALL]))
+    assert cell_state(grid, 0.0, 0.0) == FREE
+    assert cell_state(grid, -0.1, 0.0) == FREE
+
+
+def test_obstacle_closer_than_min_depth_stops_clearing():
+    # a box 0.3 m ahead reads 0 (closer than the camera's 0.5 m): nothing behind it may become free
+    box = ((0.3, -0.4, 0.0), (0.6, 0.4, 1.2))
+    frame = render_boxes(Pose2D(0, 0, 0), [box, WALL])
+    depth = np.array(frame.depth)
+    depth[depth < 0.5] = 0.0
+    grid = OccupancyGrid(OccupancyConfig(depth_stride=1))
+    grid.integrate(
+        Frame(
+            rgb=frame.rgb,
+            depth=depth,
+            intrinsics=K,
+            T_world_cam=frame.T_world_cam,
+            base_pose=frame.base_pose,
+            stamp=0.0,
+        )
+    )
+    for x in (0.35, 0.45, 0.55, 1.0):
+        assert cell_state(grid, x, 0.0) != FREE, x

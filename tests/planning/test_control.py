@@ -1,0 +1,177 @@
+"""Local planner, discrete converter and Navigator behaviour on hand-made grids (no simulator)."""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+import pytest
+
+from hiconav.mapping import GridSnapshot
+from hiconav.mapping.occupancy import disk_kernel
+from hiconav.planning import Navigator, PurePursuit, heading_action, lookahead_point, to_discrete
+from hiconav.planning.local_planner import segment_target
+from hiconav.types import DiscreteAction, Goal, Pose2D, VelocityCommand
+
+RES = 0.05
+
+
+def snapshot(state: np.ndarray) -> GridSnapshot:
+    occ = (state == 1).astype(np.uint8)
+    inflated = cv2.dilate(occ, disk_kernel(5.0)).astype(bool)
+    return GridSnapshot(
+        state=state.astype(np.int8),
+        inflated=inflated,
+        explored=state != -1,
+        origin=np.zeros(2),
+        resolution=RES,
+        version=1,
+        stamp=0.0,
+    )
+
+
+def open_room(n: int = 100) -> np.ndarray:
+    s = np.zeros((n, n), np.int8)
+    s[0, :] = s[-1, :] = s[:, 0] = s[:, -1] = 1
+    return s
+
+
+def test_to_discrete_turns_to_within_15_deg_then_goes_forward():
+    p = Pose2D(0, 0, 0)
+    assert to_discrete(p, np.array([1.0, 0.1])) == DiscreteAction.MOVE_FORWARD  # 5.7 deg
+    assert to_discrete(p, np.array([1.0, 0.5])) == DiscreteAction.TURN_LEFT  # 26.6 deg
+    assert to_discrete(p, np.array([1.0, -0.5])) == DiscreteAction.TURN_RIGHT
+    assert to_discrete(p, np.array([-1.0, -0.01])) == DiscreteAction.TURN_RIGHT  # shortest way round
+    assert heading_action(Pose2D(0, 0, math.radians(170)), math.radians(-175)) is None  # wraps
+
+
+def test_lookahead_point_walks_along_the_path():
+    path = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
+    pt, seg = lookahead_point(path, np.array([0.5, 0.1]), 0.7)
+    np.testing.assert_allclose(pt, [1.0, 0.2], atol=1e-9)
+    assert seg == 1
+    pt, _ = lookahead_point(path, np.array([0.9, 0.9]), 5.0)
+    np.testing.assert_allclose(pt, [1.0, 1.0])
+    # never past the first corner ahead while it is farther than the switch distance
+    np.testing.assert_allclose(segment_target(path, np.array([0.5, 0.0]), 0.7, 0.1), [1.0, 0.0])
+
+
+def test_pure_pursuit_respects_limits_and_turns_in_place_for_large_errors():
+    pp = PurePursuit()
+    c = pp.config
+    path = np.array([[0.0, 0.0], [3.0, 0.0]])
+    cmd = pp.command(Pose2D(0, 0, 0), path, dt=0.1)
+    assert 0 < cmd.v <= c.accel_max * 0.1 + 1e-9  # acceleration limit from standstill
+    for _ in range(30):
+        cmd = pp.command(Pose2D(0, 0, 0), path, dt=0.1)
+    assert cmd.v == pytest.approx(c.v_max) and abs(cmd.omega) < 1e-9
+    cmd = pp.command(Pose2D(0, 0, math.pi), path, dt=0.1)  # facing away: rotate on the spot
+    assert cmd.v == 0.0 and abs(cmd.omega) == pytest.approx(c.omega_max)
+    cmd = pp.command(Pose2D(0, 0.0, 0.3), path, dt=0.1)
+    assert cmd.omega < 0 and abs(cmd.omega) <= c.omega_max + 1e-9
+
+
+def simulate_discrete(
+    nav: Navigator, grid: GridSnapshot, pose: Pose2D, true_blocked: np.ndarray | None = None, steps: int = 200
+) -> tuple[Pose2D, list[DiscreteAction]]:
+    """Kinematic stand-in for the simulator: forward 0.25 m unless the end cell is truly blocked."""
+    actions = []
+    for _ in range(steps):
+        a = nav.step(grid, pose)
+        actions.append(a)
+        if a == DiscreteAction.STOP:
+            break
+        if a == DiscreteAction.TURN_LEFT:
+            pose = Pose2D(pose.x, pose.y, pose.yaw + math.radians(30))
+        elif a == DiscreteAction.TURN_RIGHT:
+            pose = Pose2D(pose.x, pose.y, pose.yaw - math.radians(30))
+        elif a == DiscreteAction.MOVE_FORWARD:
+            nxt = Pose2D(pose.x + 0.25 * math.cos(pose.yaw), pose.y + 0.25 * math.sin(pose.yaw), pose.yaw)
+            rc = grid.world_to_cell(nxt.xy)
+            if true_blocked is None or not true_blocked[rc[0], rc[1]]:
+                pose = nxt
+    return pose, actions
+
+
+def test_navigator_reaches_a_goal_around_a_wall():
+    s = open_room()
+    s[20:100, 50] = 1  # wall with a gap at the bottom (rows 1..19)
+    grid = snapshot(s)
+    nav = Navigator()
+    nav.set_goal(Goal(4.0, 4.0, tolerance=0.25))
+    pose, actions = simulate_discrete(nav, grid, Pose2D(1.0, 4.0, 0.0))
+    assert nav.reached and actions[-1] == DiscreteAction.STOP
+    assert np.hypot(pose.x - 4.0, pose.y - 4.0) <= 0.25
+    assert nav.path_xy is not None and nav.n_plans >= 1
+
+
+def test_goal_yaw_is_reached_after_position():
+    grid = snapshot(open_room())
+    nav = Navigator()
+    nav.set_goal(Goal(2.5, 2.5, yaw=-math.pi / 2, tolerance=0.3))
+    pose, _ = simulate_discrete(nav, grid, Pose2D(1.0, 1.0, 0.0))
+    assert nav.reached and abs((pose.yaw + math.pi / 2 + math.pi) % (2 * math.pi) - math.pi) <= math.radians(
+        15
+    )
+
+
+def test_unreachable_goal_stops_with_no_path():
+    s = open_room()
+    s[:, 50] = 1
+    nav = Navigator()
+    nav.set_goal(Goal(4.0, 2.5))
+    assert nav.step(snapshot(s), Pose2D(1.0, 2.5, 0.0)) == DiscreteAction.STOP
+    assert not nav.reached and nav.status == "no_path"
+    nav.set_goal(None)
+    assert nav.step(snapshot(s), Pose2D(1.0, 2.5, 0.0)) == DiscreteAction.STOP and nav.status == "idle"
+
+
+def test_replans_when_the_path_becomes_blocked():
+    grid = snapshot(open_room())
+    nav = Navigator()
+    nav.set_goal(Goal(4.0, 2.5))
+    nav.step(grid, Pose2D(1.0, 2.5, 0.0))
+    assert nav.path_xy is not None and len(nav.path_xy) == 2  # straight line
+    s = open_room()
+    s[30:70, 50] = 1  # a new obstacle across the straight line
+    blocked_grid = snapshot(s)
+    plans = nav.n_plans
+    nav.step(blocked_grid, Pose2D(1.0, 2.5, 0.0))
+    assert nav.n_plans == plans + 1 and len(nav.path_xy) > 2
+
+
+def test_recovers_when_stuck_on_an_unmapped_obstacle():
+    grid = snapshot(open_room())
+    truth = np.zeros((100, 100), bool)
+    truth[30:70, 40:44] = True  # invisible to the map: a glass wall
+    nav = Navigator()
+    nav.set_goal(Goal(4.0, 2.5, tolerance=0.25))
+    pose, actions = simulate_discrete(nav, grid, Pose2D(1.0, 2.5, 0.0), true_blocked=truth, steps=300)
+    assert nav.n_recoveries >= 1 or len(nav._virtual) >= 1
+    assert nav.reached, nav.status
+    assert np.hypot(pose.x - 4.0, pose.y - 2.5) <= 0.25
+
+
+def test_velocity_mode_backs_off_when_stuck():
+    grid = snapshot(open_room())
+    nav = Navigator()
+    nav.set_goal(Goal(4.0, 2.5))
+    pose = Pose2D(1.0, 2.5, 0.0)
+    cmds = [nav.step_velocity(grid, pose, dt=0.1) for _ in range(40)]  # the robot never moves
+    assert any(c.v < 0 for c in cmds), "no back-off"
+    assert nav.n_recoveries >= 1
+    assert all(isinstance(c, VelocityCommand) for c in cmds)
+
+
+def test_resending_the_same_goal_changes_nothing():
+    grid = snapshot(open_room())
+    nav = Navigator()
+    goal = Goal(2.0, 2.0, tolerance=0.3)
+    nav.set_goal(goal)
+    simulate_discrete(nav, grid, Pose2D(1.0, 2.0, 0.0))
+    assert nav.reached
+    nav.set_goal(Goal(2.0, 2.0, tolerance=0.3))
+    assert nav.reached
+    nav.set_goal(Goal(3.0, 2.0, tolerance=0.3))
+    assert not nav.reached and nav.path_xy is None
