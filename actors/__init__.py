@@ -15,5 +15,15 @@ START_ORDER: tuple[str, ...] = ("driver", "perception", "memory", "reasoning", "
 #: The fixed order in which the stepped scheduler ticks the nodes due at one virtual instant.
 TICK_ORDER: tuple[str, ...] = ("driver", "perception", "memory", "reasoning", "exploration", "mission", "control")
 
-__all__ = ["Node", "NodeStats", "Outgoing", "RUNTIME", "NodeActor", "RealtimeRuntime", "RunReport", "SteppedRuntime",
-           "START_ORDER", "TICK_ORDER"]
+__all__ = [
+           "RUNTIME",
+           "START_ORDER",
+           "TICK_ORDER",
+           "Node",
+           "NodeActor",
+           "NodeStats",
+           "Outgoing",
+           "RealtimeRuntime",
+           "RunReport",
+           "SteppedRuntime",
+]

@@ -27,10 +27,12 @@ app = typer.Typer(
 
 # (subcommand, module, function): the module owns the options and the implementation.
 SUBCOMMANDS: list[tuple[str, str, str]] = [
+    ("run", "hiconav.mission", "run_command"),
     ("sim", "hiconav.sim.cli", "sim"),
     ("vehicle", "hiconav.drivers.cli", "vehicle"),
     ("parse", "hiconav.reasoning.cli", "parse"),
     ("eval", "hiconav.eval.cli", "eval"),
+    ("tree", "hiconav.trees.cli", "tree"),
 ]
 
 

@@ -4,7 +4,14 @@
 and raises ``TreeError`` naming file:line [key]. This package never starts actors.
 """
 
-from hiconav.trees.builder import BlackboardRef, NodeDef, TreeDefinition, build_tree, find_tree_file, load_tree
+from hiconav.trees.builder import (
+           BlackboardRef,
+           NodeDef,
+           TreeDefinition,
+           build_tree,
+           find_tree_file,
+           load_tree,
+)
 from hiconav.trees.context import Candidate, MissionContext
 from hiconav.trees.errors import BlackboardError, TreeError
 from hiconav.trees.registry import BEHAVIOURS, Param, register_behaviour

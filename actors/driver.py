@@ -1,0 +1,115 @@
+"""DriverActor: the robot (here the built-in simulator) behind a Node.
+
+Executes the newest command (latest-wins; stale commands are dropped and counted), publishes the
+resulting frame to perception, and ends the episode on STOP, on the step limit, or on an
+emergency stop (zero command; further commands are ignored). It never decides anything.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import numpy as np
+from hiconav.actors.node import Node
+from hiconav.actors.runtime import NodeActor
+
+from hiconav.messages import CommandMsg, EpisodeEnded, FrameMsg
+from hiconav.types import DiscreteAction, Pose2D, VelocityCommand
+
+
+class DriverActor(NodeActor):
+    """pykka actor of the driver (the robot / simulator)."""
+
+
+class DriverNode(Node):
+    """Owns the simulator (``reset``/``step``/``step_velocity``/``observe``, ``steps``, ``pose``).
+
+    trajectory: (N, 3) x, y, yaw after each executed action, starting with the reset pose.
+    """
+
+    name = "driver"
+    actor_class = DriverActor
+
+    def __init__(self, sim: Any, start: Pose2D, *, rate_hz: float = 10.0, max_steps: int = 500,
+                 velocity_dt: float = 0.1, frame_to: tuple[str, ...] = ("perception",),
+                 ended_to: tuple[str, ...] = ("runtime", "mission", "recorder")) -> None:
+        super().__init__(rate_hz)
+        self.sim = sim
+        self.start_pose = start
+        self.max_steps = max_steps
+        self.velocity_dt = velocity_dt
+        self.frame_to = frame_to
+        self.ended_to = ended_to
+        self.ended: EpisodeEnded | None = None
+        self.trajectory: list[tuple[float, float, float]] = []
+        self.actions: list[str] = []
+        self.last_command: VelocityCommand | DiscreteAction | None = None
+        self._pending_frame: Any = None
+        self.latest_wins(CommandMsg)
+
+    def start(self, now: float) -> None:
+        self._pending_frame = self.sim.reset(self.start_pose)
+        self._record()
+
+    def _record(self) -> None:
+        p = self.sim.pose
+        self.trajectory.append((float(p.x), float(p.y), float(p.yaw)))
+
+    def _end(self, reason: str, now: float) -> None:
+        if self.ended is None:
+            self.ended = EpisodeEnded(reason, int(self.sim.steps), now)
+            self.emit(self.ended_to, self.ended)
+
+    def tick(self, now: float) -> None:
+        if self._pending_frame is not None:
+            self.emit(self.frame_to, FrameMsg(self._pending_frame, int(self.sim.steps)))
+            self._pending_frame = None
+        cmd = self.take(CommandMsg)
+        if cmd is None or self.ended is not None:
+            return
+        if cmd.action is not None:
+            self.last_command = cmd.action
+            self.actions.append(cmd.action.value)
+            frame = self.sim.step(cmd.action)
+            self._record()
+            if cmd.action == DiscreteAction.STOP:
+                self._end("stop", now)
+                return
+        elif cmd.velocity is not None:
+            self.last_command = cmd.velocity
+            frame = self.sim.step_velocity(cmd.velocity, self.velocity_dt)
+            self._record()
+        else:
+            return
+        if self.sim.steps >= self.max_steps:
+            self._end("max_steps", now)
+            return
+        self.emit(self.frame_to, FrameMsg(frame, int(self.sim.steps)))
+
+    def emergency_stop(self, reason: str, now: float) -> None:
+        """Zero command: nothing moves any more; the episode ends (reason 'emergency')."""
+        self.last_command = VelocityCommand.zero(now)
+        self.take(CommandMsg)
+        self._end("emergency", now)
+
+    def stop(self, now: float) -> None:
+        close = getattr(self.sim, "close", None)
+        if close is not None:
+            close()
+        if threading.current_thread() is not threading.main_thread():
+            # WORKAROUND (simulator area): the renderer caches one EGL context per thread *id*, and
+            # ids are reused once a thread ends, so a later actor thread would inherit a context that
+            # is not current in it ("cannot create program"). Drop this thread's context as it ends.
+            try:
+                from hiconav.sim import renderer
+
+                ctx = renderer._THREAD_CONTEXTS.pop(threading.get_ident(), None)
+                if ctx is not None:
+                    ctx.release()
+            except Exception:  # the renderer may have changed: the workaround is best effort
+                pass
+
+    @property
+    def path(self) -> np.ndarray:
+        return np.asarray(self.trajectory, dtype=np.float64).reshape(-1, 3)

@@ -1,0 +1,112 @@
+"""ReasoningActor: the slow layer - instruction decomposition and subgraph verification.
+
+Owns the ``Reasoner`` (priority queue of subgraphs), a verifier (VLM or the labelled offline
+verifier) and the instruction parser. One request at a time, as fast as the verifier answers:
+
+- ``ParseRequest`` -> ``decompose_instruction`` -> ``TaskMsg`` to mission, exploration, memory;
+- on each tick with a task and a new ``WorldSnapshot`` (latest-wins): decompose the memory graph
+  into subgraphs, update the queue, verify the next subgraph, send ``HypothesisMsg`` when found.
+
+Latency: in stepped time a reply becomes visible ``latency`` virtual seconds after the request
+(the configured latency, else the measured one) and the node stays busy until then; in real time
+the call itself takes that long on this actor's thread while the fast layer runs on. A rejected
+target (``TargetRejected`` from the mission) retracts the confirmation so that the search goes on.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+from hiconav.actors.node import Node
+from hiconav.actors.runtime import NodeActor
+
+from hiconav.messages import HypothesisMsg, ParseRequest, TargetRejected, TaskMsg, WorldSnapshot
+
+
+class ReasoningActor(NodeActor):
+    """pykka actor of the reasoning layer."""
+
+
+class ReasoningNode(Node):
+    name = "reasoning"
+    actor_class = ReasoningActor
+
+    def __init__(self, *, parse: Callable[[str], Any], make_reasoner: Callable[[Any], Any] | None,
+                 verifier: Any = None, decompose: Callable[..., list] | None = None,
+                 similarity: Callable[[str, str], float] | None = None, k: int = 5, rate_hz: float = 10.0,
+                 stepped: bool = True, latency_s: float | None = None, parse_latency_s: float | None = None,
+                 task_to: tuple[str, ...] = ("mission", "exploration", "memory")) -> None:
+        super().__init__(rate_hz)
+        self.parse = parse
+        self.make_reasoner = make_reasoner
+        self.verifier = verifier
+        self.decompose = decompose
+        self.similarity = similarity
+        self.k = k
+        self.stepped = stepped
+        self.latency_s = latency_s
+        self.parse_latency_s = parse_latency_s
+        self.task_to = task_to
+        self.task = None
+        self.reasoner: Any = None
+        self.busy_until = 0.0
+        self.requests = 0
+        self.events: list[dict[str, Any]] = []
+        self._parse: ParseRequest | None = None
+        self.latest_wins(WorldSnapshot)
+        self.on(ParseRequest, lambda m, now: setattr(self, "_parse", m))
+        self.on(TaskMsg, self._on_task)
+        self.on(TargetRejected, self._on_rejected)
+
+    def _on_task(self, msg: TaskMsg, now: float) -> None:
+        self._set_task(msg.task)
+
+    def _set_task(self, task: Any) -> None:
+        self.task = task
+        self.reasoner = self.make_reasoner(task) if self.make_reasoner is not None else None
+
+    def _on_rejected(self, msg: TargetRejected, now: float) -> None:
+        if self.reasoner is not None:
+            self.reasoner.retract(msg.reason)
+
+    def _delay(self, configured: float | None, measured: float) -> float:
+        if not self.stepped:
+            return max((configured or 0.0) - measured, 0.0)  # real time: the call already took `measured`
+        return configured if configured is not None else measured
+
+    def tick(self, now: float) -> None:
+        if now < self.busy_until - 1e-9:
+            return  # the previous reply is not visible yet (stepped time)
+        if self._parse is not None:
+            request, self._parse = self._parse, None
+            t0 = time.perf_counter()
+            task = self.parse(request.instruction)
+            delay = self._delay(self.parse_latency_s, time.perf_counter() - t0)
+            self._set_task(task)
+            self.busy_until = now + (delay if self.stepped else 0.0)
+            self.events.append({"t": now, "kind": "parse", "instruction": request.instruction,
+                                "targets": list(task.targets), "related": list(task.related), "latency_s": delay})
+            self.emit(self.task_to, TaskMsg(task, now + delay), delay)
+            return
+        snap = self.take(WorldSnapshot)
+        if (snap is None or self.reasoner is None or self.verifier is None or self.decompose is None
+                or snap.memory is None or self.reasoner.done):
+            return
+        subgraphs = self.decompose(snap.memory, self.task, self.similarity, k=self.k)
+        self.reasoner.update(subgraphs)
+        subgraph = self.reasoner.next()
+        if subgraph is None:
+            return
+        result = self.verifier.verify(subgraph, self.task)
+        self.reasoner.accept(result)
+        self.requests += 1
+        delay = self._delay(self.latency_s, float(result.latency_s))
+        self.busy_until = now + (delay if self.stepped else 0.0)
+        self.events.append({"t": now, "kind": "verify", "subgraph": getattr(subgraph, "kind", ""),
+                            "found": bool(result.found), "reason": result.reason, "latency_s": delay,
+                            "source": result.source})
+        if result.found and result.hypothesis is not None:
+            self.emit(("mission", "memory", "recorder"), HypothesisMsg(result.hypothesis, now + delay, now, "", result.detail,
+                                                           str(getattr(subgraph, "kind", ""))), delay)

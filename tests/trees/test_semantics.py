@@ -1,0 +1,243 @@
+"""Tree semantics over a MissionContext: preemption calls terminate(), clocks, rejection, blackboard."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import py_trees
+import pytest
+from hiconav.trees import BlackboardError, MissionContext
+from hiconav.trees.mission_tree import MissionTree
+
+from hiconav.messages import GoalMsg, NavStatus, ParseRequest, StopRequest
+from hiconav.types import Pose2D, TaskSpec
+
+from .fakes import obj, plan, world
+
+S = py_trees.common.Status
+
+
+class Clock:
+    def __init__(self) -> None:
+        self.t = 0.0
+
+    def __call__(self) -> float:
+        return self.t
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    f = tmp_path / "m.yaml"
+    f.write_text(text)
+    return f
+
+
+def _ctx(clock: Clock, **kw) -> MissionContext:
+    ctx = MissionContext(instruction="find the bed", clock=clock, **kw)
+    ctx.task = TaskSpec("find the bed", ("bed",))
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0))
+    return ctx
+
+
+def _node(tree: MissionTree, name: str):
+    return next(n for n in tree.root.iterate() if n.name == name)
+
+
+FIND = """
+root:
+  Selector:
+    name: find
+    memory: false
+    children:
+      - TargetConfirmed: {}
+      - Explore: {}
+"""
+
+
+def test_preemption_by_higher_priority_calls_terminate_and_cancels_the_goal(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan((8.0, 8.0))
+    tree = MissionTree(_write(tmp_path, FIND), ctx)
+    assert tree.tick() == S.RUNNING
+    explore = _node(tree, "Explore")
+    goals = [m for m in ctx.outbox if isinstance(m, GoalMsg)]
+    assert goals and goals[-1].goal is not None and goals[-1].goal.kind == "frontier"
+    ctx.outbox.clear()
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(7, "bed", 5.0, 5.0)])
+    assert tree.tick() == S.SUCCESS
+    assert explore.terminations == [S.INVALID]
+    assert [m.goal for m in ctx.outbox if isinstance(m, GoalMsg)] == [None]
+    tree.stop()
+
+
+def test_stopping_a_running_tree_terminates_the_running_leaf(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan((8.0, 8.0))
+    tree = MissionTree(_write(tmp_path, FIND), ctx)
+    tree.tick()
+    explore = _node(tree, "Explore")
+    tree.stop()
+    assert explore.terminations == [S.INVALID]
+
+
+def test_timeout_counts_mission_clock_seconds(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan((8.0, 8.0))
+    tree = MissionTree(_write(tmp_path, "root:\n  Timeout:\n    duration: 5\n    child:\n      Explore: {}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    clock.t = 4.9
+    assert tree.tick() == S.RUNNING
+    clock.t = 5.1
+    assert tree.tick() == S.FAILURE
+    assert _node(tree, "Explore").terminations == [S.INVALID]
+    tree.stop()
+
+
+def test_explore_fails_when_no_frontier_is_left(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan()
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {max_idle_s: 3}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    clock.t = 3.5
+    assert tree.tick() == S.FAILURE
+
+
+def test_explore_moves_on_when_a_frontier_is_unreachable(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan((8.0, 8.0), (1.0, 8.0))
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {}\n"), ctx)
+    tree.tick()
+    first = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    ctx.nav = NavStatus(first.seq, "failed", 0.0)
+    tree.tick()
+    second = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    assert second.seq > first.seq and second.goal.ref_id == 1
+
+
+def test_verify_rejects_a_vanished_candidate_and_retry_explores_again(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan((8.0, 8.0))
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0)])
+    text = """
+root:
+  Retry:
+    num_failures: 3
+    child:
+      Sequence:
+        name: locate
+        children:
+          - Selector:
+              name: find
+              memory: false
+              children:
+                - TargetConfirmed: {}
+                - Explore: {}
+          - VerifyTarget: {}
+"""
+    tree = MissionTree(_write(tmp_path, text), ctx)
+    assert tree.tick() == S.RUNNING  # VerifyTarget going to the candidate
+    assert _node(tree, "VerifyTarget").status == S.RUNNING
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [])  # the false positive disappears from memory
+    assert tree.tick() == S.RUNNING  # Retry absorbs the failure
+    assert 3 in ctx.rejected
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0)])
+    tree.tick()
+    assert _node(tree, "Explore").status == S.RUNNING  # rejected candidate no longer confirms
+
+
+def test_verify_confirms_with_fresh_views_when_close(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.world = world(Pose2D(4.0, 4.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=4)])
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - VerifyTarget: {min_fresh_views: 2}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    ctx.world = world(Pose2D(4.0, 4.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=5)])
+    assert tree.tick() == S.RUNNING
+    ctx.world = world(Pose2D(4.0, 4.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=6)])
+    assert tree.tick() == S.SUCCESS
+
+
+def test_approach_sends_a_free_cell_within_distance_facing_the_target(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.world = world(Pose2D(1.5, 1.5, 0.0), [obj(3, "bed", 5.0, 5.0)])
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - Approach: {distance: 0.8}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert goal.kind == "approach"
+    dx = max(4.5 - goal.x, 0, goal.x - 5.5)
+    dy = max(4.5 - goal.y, 0, goal.y - 5.5)
+    assert math.hypot(dx, dy) <= 0.8
+    assert abs(goal.yaw - math.atan2(5.0 - goal.y, 5.0 - goal.x)) < 1e-9
+    ctx.world = world(Pose2D(goal.x, goal.y, goal.yaw), [obj(3, "bed", 5.0, 5.0)])
+    assert tree.tick() == S.SUCCESS
+
+
+def test_parse_instruction_reads_the_blackboard_and_waits_for_the_task(tmp_path):
+    clock = Clock()
+    ctx = MissionContext(instruction="", clock=clock)
+    tree = MissionTree(_write(tmp_path, "root:\n  ParseInstruction: {instruction: '{goal_text}'}\n"), ctx,
+                       blackboard={"goal_text": "find the sofa"})
+    assert tree.tick() == S.RUNNING
+    assert [m.instruction for m in ctx.outbox if isinstance(m, ParseRequest)] == ["find the sofa"]
+    assert tree.tick() == S.RUNNING
+    ctx.task = TaskSpec("find the sofa", ("sofa",))
+    assert tree.tick() == S.SUCCESS
+    tree.stop()
+
+
+def test_blackboard_value_of_the_wrong_type_names_file_and_line(tmp_path):
+    ctx = MissionContext(instruction="", clock=Clock())
+    f = _write(tmp_path, "root:\n  Explore:\n    max_idle_s: '{patience}'\n")
+    tree = MissionTree(f, ctx, blackboard={"patience": "long"})
+    ctx.plan = plan()
+    with pytest.raises(BlackboardError, match=f"{f}:3"):
+        tree.tick()
+
+
+def test_missions_do_not_share_blackboards(tmp_path):
+    f = _write(tmp_path, "root:\n  ParseInstruction: {}\n")
+    a = MissionContext(instruction="", clock=Clock())
+    b = MissionContext(instruction="", clock=Clock())
+    ta = MissionTree(f, a, blackboard={"instruction": "find the bed"})
+    tb = MissionTree(f, b, blackboard={"instruction": "find the tv"})
+    ta.tick()
+    tb.tick()
+    assert a.outbox[0].instruction == "find the bed" and b.outbox[0].instruction == "find the tv"
+    ta.stop()
+    tb.stop()
+
+
+def test_stop_requests_the_stop_action_once(tmp_path):
+    ctx = _ctx(Clock())
+    tree = MissionTree(_write(tmp_path, "root:\n  Stop: {}\n"), ctx)
+    assert tree.tick() == S.SUCCESS
+    tree.tick()
+    assert len([m for m in ctx.outbox if isinstance(m, StopRequest)]) == 1
+
+
+def test_find_and_return_goes_home_on_a_health_alert():
+    from hiconav.messages import HealthAlert
+
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.start_pose = Pose2D(1.0, 1.0, 0.0)
+    ctx.plan = plan((8.0, 8.0))
+    tree = MissionTree("find_and_return", ctx)
+    tree.tick()
+    tree.tick()
+    explore = _node(tree, "Explore")
+    assert explore.status == S.RUNNING
+    ctx.alerts.append(HealthAlert("battery", "battery at 10%"))
+    tree.tick()
+    assert explore.terminations[-1] == S.INVALID
+    assert _node(tree, "ReturnToStart").status == S.RUNNING
+    tree.stop()

@@ -1,0 +1,88 @@
+"""Base class of the mission behaviours: parameters (literal or ``{key}``), context, blackboard.
+
+A ``MissionBehaviour`` receives its validated parameters from the YAML builder and the mission's
+``MissionContext`` in ``setup(context=...)``. ``param(key)`` returns the literal, or reads the
+blackboard for a ``{key}`` parameter and checks its type against the declaration, naming the
+YAML file:line on a mismatch. Subclasses do their work in ``update()`` and return quickly; they
+must never block a tick (no waiting on futures, no sleeping).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import py_trees
+from hiconav.trees.builder import BlackboardRef
+from hiconav.trees.context import MissionContext
+from hiconav.trees.errors import BlackboardError, TreeError
+from hiconav.trees.registry import Param
+
+Status = py_trees.common.Status
+
+
+class MissionBehaviour(py_trees.behaviour.Behaviour):
+    """A leaf of a mission tree; ``PARAMS`` declares its YAML parameters, ``WRITES`` its outputs."""
+
+    PARAMS: dict[str, Param] = {}
+    WRITES: tuple[str, ...] = ()
+    READS: tuple[str, ...] = ()
+
+    def __init__(self, name: str, params: dict[str, Any] | None = None, origin: dict[str, str] | None = None):
+        super().__init__(name)
+        given = dict(params or {})
+        for key, decl in self.PARAMS.items():
+            if key not in given and not decl.required:
+                given[key] = decl.default
+        self._params = given
+        self._origin = dict(origin or {})
+        self.ctx: MissionContext | None = None
+        self.bb: Any = None
+        self.terminations: list[Status] = []  # every terminate() status, for tests and the report
+
+    # -- life cycle ------------------------------------------------------------------------------
+    def setup(self, **kwargs: Any) -> None:
+        ctx = kwargs.get("context")
+        if not isinstance(ctx, MissionContext):
+            raise TreeError(f"{type(self).__name__} {self.name!r} needs setup(context=MissionContext)")
+        self.ctx = ctx
+        self.bb = self.attach_blackboard_client(name=self.name, namespace=ctx.namespace)
+        keys = {v.key for v in self._params.values() if isinstance(v, BlackboardRef)} | set(self.READS)
+        for key in sorted(keys - set(self.WRITES)):
+            self.bb.register_key(key=key, access=py_trees.common.Access.READ)
+        for key in self.WRITES:
+            self.bb.register_key(key=key, access=py_trees.common.Access.WRITE)
+
+    def terminate(self, new_status: Status) -> None:
+        self.terminations.append(new_status)
+        self.cleanup(new_status)
+
+    def cleanup(self, new_status: Status) -> None:
+        """Undo what ``initialise`` started (cancel goals...); called on success, failure and preemption."""
+
+    # -- parameters ------------------------------------------------------------------------------
+    def param(self, key: str) -> Any:
+        value = self._params[key]
+        if not isinstance(value, BlackboardRef):
+            return value
+        where = self._origin.get(key, "?")
+        file, _, line = where.rpartition(":")
+        if self.bb is None or not self.bb.exists(value.key):
+            raise BlackboardError(f"{type(self).__name__}.{key} reads blackboard key {value.key!r}, which is not set",
+                                  file=file or None, line=int(line) if line.isdigit() else None, field=key)
+        got = self.bb.get(value.key)
+        problem = self.PARAMS[key].check(got)
+        if problem is not None:
+            raise BlackboardError(f"{type(self).__name__}.{key} from blackboard key {value.key!r}: {problem}",
+                                  file=file or None, line=int(line) if line.isdigit() else None, field=key)
+        return got
+
+    def write(self, key: str, value: Any) -> None:
+        self.bb.set(key, value, overwrite=True)
+
+    def read(self, key: str, default: Any = None) -> Any:
+        return self.bb.get(key) if self.bb.exists(key) else default
+
+    @property
+    def context(self) -> MissionContext:
+        assert self.ctx is not None, "setup(context=...) was not called"
+        return self.ctx

@@ -1,0 +1,451 @@
+"""The ObjectNav mission behaviours: ParseInstruction, TargetConfirmed, Explore, VerifyTarget,
+Approach, ReturnToStart, Stop.
+
+Each one polls the ``MissionContext`` (results the actors delivered) and posts requests to it
+(goals, parse and stop requests) that the Mission actor turns into messages: ``initialise()``
+starts the work, ``update()`` checks progress and returns at once, ``terminate()`` cancels what
+was started (including when a higher-priority branch preempts it). Nothing here blocks, sleeps or
+talks to an actor directly.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import py_trees
+from hiconav.trees.behaviours.base import MissionBehaviour, Status
+from hiconav.trees.context import Candidate
+from hiconav.trees.registry import Param, register_behaviour
+
+from hiconav.types import Goal, wrap_angle
+
+
+def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy: np.ndarray,
+                  max_distance: float, exclude: list[np.ndarray] | None = None) -> np.ndarray | None:
+    """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint.
+
+    grid: snapshot with ``state`` (H, W) int8 (0 free), ``inflated`` (H, W) bool, ``origin`` (2,),
+    ``resolution``; box_min / box_max: (3,) world metres (only x, y used); robot_xy: (2,) world.
+    Returns the (2,) world xy of the chosen cell centre (nearest to the robot), or None.
+    """
+    from scipy import ndimage
+
+    state = np.asarray(grid.state)
+    free = (state == 0) & ~np.asarray(grid.inflated, dtype=bool)
+    res = float(grid.resolution)
+    ox, oy = float(grid.origin[0]), float(grid.origin[1])
+    h, w = free.shape
+    r0 = max(int((box_min[1] - max_distance - oy) / res) - 1, 0)
+    r1 = min(int((box_max[1] + max_distance - oy) / res) + 2, h)
+    c0 = max(int((box_min[0] - max_distance - ox) / res) - 1, 0)
+    c1 = min(int((box_max[0] + max_distance - ox) / res) + 2, w)
+    if r0 >= r1 or c0 >= c1:
+        return None
+    labels, _ = ndimage.label(free)
+    rr = int(np.clip((robot_xy[1] - oy) / res, 0, h - 1))
+    rc = int(np.clip((robot_xy[0] - ox) / res, 0, w - 1))
+    robot_label = labels[rr, rc]
+    if robot_label == 0:  # robot cell itself inflated/unknown: use the nearest free component
+        near = labels[max(rr - 6, 0):rr + 7, max(rc - 6, 0):rc + 7]
+        robot_label = int(np.bincount(near[near > 0]).argmax()) if np.any(near > 0) else 0
+    rows, cols = np.mgrid[r0:r1, c0:c1]
+    x = ox + (cols + 0.5) * res
+    y = oy + (rows + 0.5) * res
+    dx = np.maximum(np.maximum(box_min[0] - x, 0.0), x - box_max[0])
+    dy = np.maximum(np.maximum(box_min[1] - y, 0.0), y - box_max[1])
+    ok = (np.hypot(dx, dy) <= max_distance) & free[r0:r1, c0:c1]
+    if robot_label:
+        ok &= labels[r0:r1, c0:c1] == robot_label
+    for ex in exclude or []:
+        ok &= np.hypot(x - ex[0], y - ex[1]) > 0.3
+    if not np.any(ok):
+        return None
+    cost = np.hypot(x - robot_xy[0], y - robot_xy[1])
+    cost = np.where(ok, cost, np.inf)
+    i = int(np.argmin(cost))
+    return np.array([x.flat[i], y.flat[i]])
+
+
+def _facing(xy: np.ndarray, center: np.ndarray) -> float:
+    return math.atan2(center[1] - xy[1], center[0] - xy[0])
+
+
+@register_behaviour()
+class ParseInstruction(MissionBehaviour):
+    """Decompose the instruction into target/related objects (reasoning layer); writes ``task``."""
+
+    PARAMS = {
+        "instruction": Param(str, "{instruction}", doc="the instruction, or {key}"),
+        "timeout_s": Param(float, 60.0, minimum=0.0, maximum=3600.0),
+    }
+    WRITES = ("task",)
+
+    def initialise(self) -> None:
+        self._start = self.context.now()
+        instruction = self.param("instruction")
+        if self.context.task is None or self.context.task.instruction != instruction:
+            self.context.task = None
+            self.context.instruction = instruction
+            self.context.request_task(instruction)
+
+    def update(self) -> Status:
+        task = self.context.task
+        if task is not None:
+            self.write("task", task)
+            self.feedback_message = f"targets {list(task.targets)} related {list(task.related)}"
+            return Status.SUCCESS
+        if self.context.now() - self._start > self.param("timeout_s"):
+            self.feedback_message = "no task from the reasoning layer"
+            return Status.FAILURE
+        return Status.RUNNING
+
+
+@register_behaviour()
+class TargetConfirmed(MissionBehaviour):
+    """Condition: a target candidate (hypothesis or memory match) exists; writes ``target``."""
+
+    PARAMS = {
+        "min_confidence": Param(float, 0.0, minimum=0.0, maximum=1.0),
+        "min_observations": Param(int, 1, minimum=1, maximum=1000),
+    }
+    WRITES = ("target",)
+
+    def update(self) -> Status:
+        for cand in self.context.candidates():
+            if cand.confidence >= self.param("min_confidence") and cand.n_obs >= self.param("min_observations"):
+                self.write("target", cand)
+                self.feedback_message = f"{cand.label} #{cand.object_id} ({cand.source})"
+                return Status.SUCCESS
+        self.feedback_message = "no candidate"
+        return Status.FAILURE
+
+
+@register_behaviour()
+class Explore(MissionBehaviour):
+    """Follow the exploration plan: go to the first frontier of the WTRP order, re-planned as the
+    map grows; FAILURE when no frontier is left for ``max_idle_s``."""
+
+    PARAMS = {
+        "max_idle_s": Param(float, 15.0, minimum=0.0, maximum=3600.0, doc="no frontier for this long: fail"),
+        "goal_tolerance": Param(float, 0.3, minimum=0.05, maximum=5.0),
+        "switch_distance": Param(float, 0.5, minimum=0.0, maximum=10.0, doc="re-send a goal that moved this far"),
+        "look_turns": Param(int, 4, minimum=0, maximum=100, doc="quarter turns in place when no frontier is known"),
+    }
+
+    def initialise(self) -> None:
+        self._seq: int | None = None
+        self._frontier: int | None = None
+        self._goal_xy: np.ndarray | None = None
+        self._last_progress = self.context.now()
+        self._visited: set[int] = set()
+        self._looks = 0
+
+    def _pick(self) -> tuple[int, np.ndarray] | None:
+        msg = self.context.plan
+        if msg is None:
+            return None
+        frontiers = {f.id: f for f in msg.frontiers}
+        order = list(getattr(msg.plan, "order", ()) or ())
+        goal = getattr(msg.plan, "goal", None)
+        if goal is not None and goal.id not in order:
+            order.insert(0, goal.id)
+        for fid in order:
+            if fid in frontiers and fid not in self._visited:
+                return fid, np.asarray(frontiers[fid].viewpoint, dtype=np.float64)
+        return None
+
+    def update(self) -> Status:
+        ctx = self.context
+        now = ctx.now()
+        if self._seq is not None and ctx.nav_state(self._seq) in ("reached", "failed"):
+            if self._frontier is not None:
+                self._visited.add(self._frontier)  # reached but still a frontier, or unreachable: move on
+            self._seq = None
+        pick = self._pick()
+        if pick is None:
+            if self._frontier is not None and self._seq is not None:
+                ctx.send_goal(None)
+                self._seq = None
+            pose = ctx.pose
+            if self._seq is None and pose is not None and self._looks < self.param("look_turns"):
+                # no frontier in view: turn in place (a quarter turn per look) to see around
+                self._looks += 1
+                self._frontier, self._goal_xy = None, None
+                self._seq = ctx.send_goal(Goal(pose.x, pose.y, wrap_angle(pose.yaw + math.pi / 2), 0.5, "look"))
+                self._last_progress = now
+            if now - self._last_progress > self.param("max_idle_s"):
+                self.feedback_message = "no frontier left"
+                return Status.FAILURE
+            self.feedback_message = "looking around" if self._seq is not None else "waiting for a frontier"
+            return Status.RUNNING
+        self._last_progress = now
+        self._looks = 0
+        fid, xy = pick
+        moved = self._goal_xy is None or float(np.hypot(*(xy - self._goal_xy))) > self.param("switch_distance")
+        if self._seq is None or fid != self._frontier or moved:
+            self._seq = ctx.send_goal(Goal(float(xy[0]), float(xy[1]), None, self.param("goal_tolerance"),
+                                           "frontier", int(fid)))
+            self._frontier, self._goal_xy = fid, xy
+        self.feedback_message = f"frontier #{fid}"
+        return Status.RUNNING
+
+    def cleanup(self, new_status: Status) -> None:
+        if getattr(self, "_seq", None) is not None and self.ctx is not None:
+            self.ctx.send_goal(None)
+            self._seq = None
+
+
+class _GoToObject(MissionBehaviour):
+    """Shared machinery: choose a free cell near the candidate's footprint and go there facing it."""
+
+    READS = ("target",)
+
+    def _send(self, cand: Candidate, distance: float) -> bool:
+        ctx = self.context
+        pose = ctx.pose
+        if pose is None or ctx.grid is None:
+            return False
+        robot = np.array([pose.x, pose.y])
+        cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded)
+        if cell is None:
+            return False
+        self._cell = cell
+        self._seq = ctx.send_goal(Goal(float(cell[0]), float(cell[1]), _facing(cell, cand.center), 0.2,
+                                       "approach", cand.object_id))
+        return True
+
+    def cleanup(self, new_status: Status) -> None:
+        if getattr(self, "_seq", None) is not None and self.ctx is not None and new_status != Status.SUCCESS:
+            self.ctx.send_goal(None)
+        self._seq = None
+
+
+@register_behaviour()
+class VerifyTarget(_GoToObject):
+    """Go within ``verify_distance`` of the candidate, facing it, and confirm it with fresh views:
+    the target-labelled object nodes at the candidate's place gain ``min_fresh_views`` new
+    observations while the robot is close. A candidate that vanishes from memory or changes label
+    is rejected for good (a false positive); one that cannot be reached or re-observed in time is
+    deferred for ``defer_s`` (rejected for good after ``max_deferrals``), so exploration resumes."""
+
+    PARAMS = {
+        "verify_distance": Param(float, 1.5, minimum=0.3, maximum=10.0),
+        "min_fresh_views": Param(int, 2, minimum=0, maximum=100),
+        "min_confidence": Param(float, 0.3, minimum=0.0, maximum=1.0),
+        "timeout_s": Param(float, 60.0, minimum=0.1, maximum=3600.0),
+        "support_radius": Param(float, 1.0, minimum=0.0, maximum=5.0, doc="same-label nodes this close count"),
+        "defer_s": Param(float, 30.0, minimum=0.0, maximum=3600.0),
+        "max_deferrals": Param(int, 2, minimum=1, maximum=100),
+    }
+    WRITES = ("target",)
+    READS = ()
+    _GLANCES = (30.0, -30.0, 0.0)  # degrees from facing the target
+
+    def initialise(self) -> None:
+        self._start = self.context.now()
+        self._seq = None
+        self._excluded: list[np.ndarray] = []
+        self._cand: Candidate | None = self.read("target")
+        self._support_close: int | None = None
+        self._glance = 0
+        if self._cand is not None and self.context.verify:
+            self._send(self._cand, self._goal_distance())
+
+    def _goal_distance(self) -> float:
+        return max(self.param("verify_distance") - 0.35, 0.3)
+
+    def _support(self, cand: Candidate) -> tuple[int, float]:
+        """Observations and best confidence of target-labelled nodes near the candidate."""
+        memory = self.context.memory
+        labels = set(self.context.task.targets) if self.context.task is not None else {cand.label}
+        labels.add(cand.label)
+        n, conf = 0, 0.0
+        for o in memory.objects:
+            if o.label in labels and float(np.hypot(*(np.asarray(o.center)[:2] - cand.center[:2]))) <= \
+                    self.param("support_radius") + 1e-9:
+                n += int(o.n_obs)
+                conf = max(conf, float(o.confidence))
+        return n, conf
+
+    def _reject(self, why: str, permanent: bool) -> Status:
+        cand = self._cand
+        if cand is not None:
+            ctx = self.context
+            count = sum(1 for oid, _ in ctx.rejections if oid == cand.object_id) + 1
+            ctx.reject(cand.object_id, why, permanent=permanent or count >= self.param("max_deferrals"),
+                       defer_s=self.param("defer_s"))
+        self.feedback_message = f"{'rejected' if permanent else 'deferred'}: {why}"
+        return Status.FAILURE
+
+    def update(self) -> Status:
+        ctx = self.context
+        cand = self._cand
+        if cand is None:
+            self.feedback_message = "no target to verify"
+            return Status.FAILURE
+        if not ctx.verify:
+            self.feedback_message = "verification disabled: candidate accepted as is"
+            return Status.SUCCESS
+        obj = ctx.object(cand.object_id)
+        if obj is None:
+            return self._reject("object node disappeared from memory", True)
+        if ctx.task is not None and obj.label not in ctx.task.targets and cand.source == "memory-label":
+            return self._reject(f"label is now {obj.label!r}", True)
+        box_min, box_max = np.asarray(obj.box_min), np.asarray(obj.box_max)
+        current = Candidate(cand.object_id, str(obj.label), np.asarray(obj.center, dtype=np.float64), box_min,
+                            box_max, float(obj.confidence), int(obj.n_obs), cand.source)
+        if ctx.distance_to_box(box_min, box_max) <= self.param("verify_distance") + 0.25:
+            support, conf = self._support(current)
+            if self._support_close is None:
+                self._support_close = support
+            fresh = support - self._support_close
+            if fresh >= self.param("min_fresh_views"):
+                if conf >= self.param("min_confidence"):
+                    self.write("target", current)
+                    self.feedback_message = f"confirmed {obj.label} #{obj.id} with {fresh} fresh views"
+                    return Status.SUCCESS
+                return self._reject(f"confidence {conf:.2f} below {self.param('min_confidence')}", True)
+        if ctx.now() - self._start > self.param("timeout_s"):
+            return self._reject("no fresh views before the timeout", False)
+        state = "pending" if self._seq is None else ctx.nav_state(self._seq)
+        if self._support_close is not None and state in ("reached", "failed"):
+            # close: glance left and right of the target so that new frames (fresh views) arrive
+            pose = ctx.pose
+            face = _facing(np.array([pose.x, pose.y]), current.center)
+            offset = math.radians(self._GLANCES[self._glance % len(self._GLANCES)])
+            self._glance += 1
+            self._seq = ctx.send_goal(Goal(pose.x, pose.y, wrap_angle(face + offset), 0.5, "look", cand.object_id))
+        elif self._seq is None or state in ("failed", "reached"):
+            if self._seq is not None and getattr(self, "_cell", None) is not None:
+                self._excluded.append(self._cell)
+            if len(self._excluded) > 3 or not self._send(current, self._goal_distance()):
+                if ctx.grid is not None and ctx.pose is not None:
+                    return self._reject("no reachable view point", False)
+        self.feedback_message = f"verifying {cand.label} #{cand.object_id}"
+        return Status.RUNNING
+
+
+@register_behaviour()
+class Approach(_GoToObject):
+    """Reach a free cell within ``distance`` of the target's footprint, facing it."""
+
+    PARAMS = {
+        "distance": Param(float, 0.8, minimum=0.1, maximum=5.0, doc="stay below the success distance"),
+        "facing_tolerance_deg": Param(float, 35.0, minimum=1.0, maximum=180.0),
+        "max_attempts": Param(int, 4, minimum=1, maximum=50),
+        "timeout_s": Param(float, 120.0, minimum=0.1, maximum=3600.0),
+    }
+
+    def initialise(self) -> None:
+        self._start = self.context.now()
+        self._seq = None
+        self._excluded: list[np.ndarray] = []
+        self._attempts = 0
+
+    def _done(self, cand: Candidate) -> bool:
+        pose = self.context.pose
+        if pose is None:
+            return False
+        close = self.context.distance_to_box(cand.box_min, cand.box_max) <= self.param("distance")
+        err = abs(wrap_angle(_facing(np.array([pose.x, pose.y]), cand.center) - pose.yaw))
+        return close and math.degrees(err) <= self.param("facing_tolerance_deg")
+
+    def update(self) -> Status:
+        ctx = self.context
+        cand: Candidate | None = self.read("target")
+        if cand is None:
+            self.feedback_message = "no target"
+            return Status.FAILURE
+        if self._done(cand):
+            self.feedback_message = f"at {cand.label} #{cand.object_id}"
+            return Status.SUCCESS
+        if ctx.now() - self._start > self.param("timeout_s"):
+            self.feedback_message = "timed out"
+            return Status.FAILURE
+        state = "pending" if self._seq is None else ctx.nav_state(self._seq)
+        if self._seq is None or state in ("failed", "reached"):
+            if self._seq is not None:
+                self._excluded.append(self._cell)
+            self._attempts += 1
+            if self._attempts > self.param("max_attempts") or \
+                    not self._send(cand, max(self.param("distance") - 0.25, 0.2)):
+                if ctx.grid is not None and ctx.pose is not None:
+                    self.feedback_message = "no reachable approach cell"
+                    return Status.FAILURE
+        self.feedback_message = f"approaching {cand.label} #{cand.object_id}"
+        return Status.RUNNING
+
+
+@register_behaviour()
+class ReturnToStart(MissionBehaviour):
+    """Go back to the pose where the mission started (second-mission example)."""
+
+    PARAMS = {
+        "tolerance": Param(float, 0.5, minimum=0.05, maximum=5.0),
+        "timeout_s": Param(float, 300.0, minimum=0.1, maximum=3600.0),
+    }
+
+    def initialise(self) -> None:
+        self._start = self.context.now()
+        start = self.context.start_pose
+        self._seq = None
+        if start is not None:
+            self._seq = self.context.send_goal(Goal(start.x, start.y, None, self.param("tolerance"), "return"))
+
+    def update(self) -> Status:
+        ctx = self.context
+        if self._seq is None:
+            return Status.FAILURE
+        pose = ctx.pose
+        start = ctx.start_pose
+        if pose is not None and start is not None and pose.distance_to(start) <= self.param("tolerance"):
+            return Status.SUCCESS
+        if ctx.nav_state(self._seq) == "failed" or ctx.now() - self._start > self.param("timeout_s"):
+            return Status.FAILURE
+        return Status.RUNNING
+
+    def cleanup(self, new_status: Status) -> None:
+        if getattr(self, "_seq", None) is not None and self.ctx is not None and new_status == Status.INVALID:
+            self.ctx.send_goal(None)
+
+
+@register_behaviour()
+class Stop(MissionBehaviour):
+    """End the episode: ask the control layer for the STOP action."""
+
+    PARAMS = {"reason": Param(str, "mission complete")}
+
+    def update(self) -> Status:
+        if not self.context.stop_requested:
+            self.context.request_stop(self.param("reason"))
+        return Status.SUCCESS
+
+
+@register_behaviour()
+class HealthOk(MissionBehaviour):
+    """Condition: no health alert (e.g. a low battery) has been reported to the mission."""
+
+    PARAMS = {"alert": Param(str, "", doc="only this alert kind ('' = any)")}
+
+    def update(self) -> Status:
+        alerts = self.context.alerts
+        kind = self.param("alert")
+        bad = [a for a in alerts if not kind or a.kind == kind]
+        self.feedback_message = bad[-1].text if bad else "ok"
+        return Status.FAILURE if bad else Status.SUCCESS
+
+
+__all__ = [
+    "Approach",
+    "Explore",
+    "HealthOk",
+    "ParseInstruction",
+    "ReturnToStart",
+    "Stop",
+    "TargetConfirmed",
+    "VerifyTarget",
+    "approach_cell",
+    "py_trees",
+]

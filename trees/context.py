@@ -1,0 +1,198 @@
+"""MissionContext: what the mission tree's behaviours read and the requests they make.
+
+The Mission actor owns one ``MissionContext``. It writes the latest actor results into it
+(task, world snapshot, exploration plan, target hypotheses, navigation status) before each tick,
+and after the tick it turns the context's outbox (goal requests, parse requests, stop) into
+messages for the other actors. Behaviours therefore *poll* results and *post* requests: they never
+block a tick and never talk to actors directly. No threads, no pykka here.
+
+Candidates: a target hypothesis from the reasoning layer (or, as a labelled fallback, a memory
+object whose label is one of the task's targets) resolved to a memory object node with a 3D box;
+the mission rejects a candidate that fails verification so that exploration resumes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from hiconav.messages import GoalMsg, NavStatus, ParseRequest, StopRequest
+from hiconav.types import Goal, Pose2D, TaskSpec
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A target candidate: a memory object node believed to be the target.
+
+    center / box_min / box_max: (3,) world metres. ``source``: "hypothesis" (reasoning layer) or
+    "memory-label" (fallback: the detector's label matched a target).
+    """
+
+    object_id: int
+    label: str
+    center: np.ndarray
+    box_min: np.ndarray
+    box_max: np.ndarray
+    confidence: float
+    n_obs: int
+    source: str
+
+
+def _box_iou_2d(a: np.ndarray, b: np.ndarray) -> float:
+    ix = max(0.0, min(a[2], b[2]) - max(a[0], b[0]))
+    iy = max(0.0, min(a[3], b[3]) - max(a[1], b[1]))
+    inter = ix * iy
+    union = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter
+    return float(inter / union) if union > 0 else 0.0
+
+
+@dataclass
+class MissionContext:
+    """Mission state shared by the behaviours of one tree (owned by the Mission actor alone)."""
+
+    instruction: str
+    clock: Callable[[], float]
+    namespace: str = "/mission"
+    success_distance: float = 1.0
+    robot_radius: float = 0.18
+    use_memory_labels: bool = True
+    verify: bool = True  # False: VerifyTarget accepts the candidate as is (the 'no_verify' ablation)
+    task: TaskSpec | None = None
+    world: Any = None  # WorldSnapshot
+    plan: Any = None  # PlanMsg
+    hypotheses: list[Any] = field(default_factory=list)  # TargetHypothesis, newest last
+    nav: NavStatus | None = None
+    rejected: set[int] = field(default_factory=set)  # object ids that failed verification for good
+    deferred: dict[int, float] = field(default_factory=dict)  # object id -> clock time it may be tried again
+    rejections: list[tuple[int, str]] = field(default_factory=list)  # every rejection/deferral, in order
+    start_pose: Pose2D | None = None
+    outbox: list[Any] = field(default_factory=list)
+    goal_seq: int = 0
+    active_goal: Goal | None = None
+    stop_requested: bool = False
+    events: list[str] = field(default_factory=list)
+    alerts: list[Any] = field(default_factory=list)  # HealthAlert messages from monitor actors
+
+    # -- time and pose -------------------------------------------------------------------------
+    def now(self) -> float:
+        return float(self.clock())
+
+    @property
+    def pose(self) -> Pose2D | None:
+        return None if self.world is None else self.world.pose
+
+    @property
+    def memory(self) -> Any:
+        return None if self.world is None else self.world.memory
+
+    @property
+    def grid(self) -> Any:
+        return None if self.world is None else self.world.grid
+
+    # -- requests (turned into messages by the Mission actor after the tick) ---------------------
+    def request_task(self, instruction: str) -> None:
+        self.outbox.append(ParseRequest(instruction, self.now()))
+
+    def send_goal(self, goal: Goal | None) -> int:
+        """Ask the control layer to go to ``goal`` (None cancels); returns the request's seq."""
+        self.goal_seq += 1
+        self.active_goal = goal
+        self.outbox.append(GoalMsg(self.goal_seq, goal, self.now()))
+        return self.goal_seq
+
+    def request_stop(self, reason: str) -> None:
+        self.stop_requested = True
+        self.outbox.append(StopRequest(reason, self.now()))
+
+    def nav_state(self, seq: int) -> str:
+        """State of goal request ``seq``: "pending" until control acknowledges it."""
+        if self.nav is None or self.nav.goal_seq != seq:
+            return "pending"
+        return self.nav.state
+
+    def excluded(self, object_id: int) -> bool:
+        """True while a candidate is rejected or deferred."""
+        return object_id in self.rejected or self.deferred.get(object_id, -1.0) > self.now()
+
+    def reject(self, object_id: int, reason: str, *, permanent: bool = True, defer_s: float = 30.0) -> None:
+        """Verification failed: exclude the candidate for good, or for ``defer_s`` clock seconds."""
+        if permanent:
+            self.rejected.add(object_id)
+        else:
+            self.deferred[object_id] = self.now() + defer_s
+        self.rejections.append((object_id, reason))
+        self.log(f"{'rejected' if permanent else 'deferred'} #{object_id}: {reason}")
+
+    def log(self, text: str) -> None:
+        self.events.append(f"{self.now():.2f} {text}")
+
+    # -- candidates ------------------------------------------------------------------------------
+    def candidates(self) -> list[Candidate]:
+        """Target candidates, best first: hypotheses (newest first) then label matches (fallback)."""
+        memory = self.memory
+        if memory is None or self.task is None:
+            return []
+        objects = {o.id: o for o in memory.objects}
+        out: list[Candidate] = []
+        seen: set[int] = set()
+        for hyp in reversed(self.hypotheses):
+            oid = self._resolve(hyp, memory, objects)
+            if oid is None or oid in seen or self.excluded(oid):
+                continue
+            seen.add(oid)
+            out.append(self._candidate(objects[oid], "hypothesis", float(getattr(hyp, "confidence", 0.0))))
+        if self.use_memory_labels:
+            targets = set(self.task.targets)
+            matches = [o for o in memory.objects if o.label in targets and not self.excluded(o.id)
+                       and o.id not in seen]
+            matches.sort(key=lambda o: (-o.confidence * o.n_obs, o.id))
+            out += [self._candidate(o, "memory-label", float(o.confidence)) for o in matches]
+        return out
+
+    def _resolve(self, hyp: Any, memory: Any, objects: dict[int, Any]) -> int | None:
+        oid = getattr(hyp, "object_id", None)
+        if oid is not None and oid in objects:
+            return int(oid)
+        try:
+            anchor = memory.anchor(hyp.anchor_id)
+        except (KeyError, LookupError, AttributeError):
+            return None
+        if anchor is None or len(anchor.object_ids) == 0:
+            return None
+        bbox = np.asarray(hyp.bbox, dtype=np.float64)
+        best, best_iou = None, 0.1
+        for oid_i, box in zip(anchor.object_ids, np.asarray(anchor.boxes)):
+            iou = _box_iou_2d(bbox, np.asarray(box, dtype=np.float64))
+            if iou > best_iou and oid_i in objects:
+                best, best_iou = int(oid_i), iou
+        return best
+
+    @staticmethod
+    def _candidate(obj: Any, source: str, confidence: float) -> Candidate:
+        return Candidate(int(obj.id), str(obj.label), np.asarray(obj.center, dtype=np.float64),
+                         np.asarray(obj.box_min, dtype=np.float64), np.asarray(obj.box_max, dtype=np.float64),
+                         confidence, int(obj.n_obs), source)
+
+    def object(self, object_id: int) -> Any:
+        memory = self.memory
+        if memory is None:
+            return None
+        for o in memory.objects:
+            if o.id == object_id:
+                return o
+        return None
+
+    def distance_to_box(self, box_min: np.ndarray, box_max: np.ndarray, xy: np.ndarray | None = None) -> float:
+        """Planar distance (m) from ``xy`` (default: the robot) to an object's footprint."""
+        if xy is None:
+            pose = self.pose
+            if pose is None:
+                return math.inf
+            xy = np.array([pose.x, pose.y])
+        dx = max(box_min[0] - xy[0], 0.0, xy[0] - box_max[0])
+        dy = max(box_min[1] - xy[1], 0.0, xy[1] - box_max[1])
+        return math.hypot(dx, dy)
