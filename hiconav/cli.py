@@ -33,6 +33,7 @@ SUBCOMMANDS: list[tuple[str, str, str]] = [
     ("parse", "hiconav.reasoning.cli", "parse"),
     ("eval", "hiconav.eval.cli", "eval"),
     ("tree", "hiconav.trees.cli", "tree"),
+    ("config", "hiconav.settings_cli", "config"),
 ]
 
 

@@ -26,6 +26,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field
 
 from hiconav.errors import ConfigError
+from hiconav.settings import _merge, nest
 from hiconav.types import Pose2D
 
 log = logging.getLogger(__name__)
@@ -72,25 +73,6 @@ class MissionConfig(BaseModel):
     # user actors by import path "package.module:NodeClass" -> keyword arguments; each is a
     # hiconav.actors.Node subclass (e.g. "hiconav.actors.monitor:BatteryMonitorNode": {"capacity_s": 300})
     extra_actors: dict[str, dict[str, Any]] = Field(default_factory=dict)
-
-
-def nest(overrides: dict[str, Any]) -> dict[str, Any]:
-    """``{"a.b": 1}`` -> ``{"a": {"b": 1}}``."""
-    out: dict[str, Any] = {}
-    for path, value in overrides.items():
-        node = out
-        parts = path.split(".")
-        for part in parts[:-1]:
-            node = node.setdefault(part, {})
-        node[parts[-1]] = value
-    return out
-
-
-def _merge(base: dict[str, Any], extra: dict[str, Any]) -> dict[str, Any]:
-    out = dict(base)
-    for k, v in extra.items():
-        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
-    return out
 
 
 def area_config(cls: type[BaseModel], overrides: dict[str, Any], area: str) -> BaseModel:
@@ -399,24 +381,21 @@ def run_command(
     clock: str = typer_option("stepped", "--clock", help="stepped (virtual time, reproducible) or real."),
     mission: str = typer_option("objectnav", "--mission", help="Mission tree: a YAML file or a name."),
     settings: list[str] = typer_option([], "--set", help="Override a setting: area.key=value (repeatable)."),
+    config_file: Path | None = typer_option(None, "--config", help="Settings YAML (sections sim, memory, ...); --set wins."),
 ) -> None:
     """Run one ObjectNav mission end to end in the built-in simulator and print the outcome."""
     import json
 
     import typer
-    import yaml
 
     from hiconav.sim import generate_episodes, load_house
 
     clock = {"realtime": "real", "real-time": "real"}.get(clock, clock)
     if clock not in ("stepped", "real"):
         raise ConfigError(f"--clock must be 'stepped' or 'real', got {clock!r}", field="clock")
-    overrides: dict[str, Any] = {}
-    for item in settings:
-        key, sep, value = item.partition("=")
-        if not sep or not key:
-            raise ConfigError(f"--set expects area.key=value, got {item!r}", field="set")
-        overrides[key.strip()] = yaml.safe_load(value)
+    from hiconav.settings import resolve
+
+    overrides = resolve(config_file, settings)  # validated: unknown keys and bad values name file:line
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
     if record is not None:

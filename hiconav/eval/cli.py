@@ -21,15 +21,15 @@ from hiconav.errors import ConfigError, DataError
 
 
 def _parse_sets(items: list[str]) -> dict[str, Any]:
-    import yaml
+    from hiconav.settings import parse_set_options
 
-    out: dict[str, Any] = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ConfigError(f"--set expects KEY=VALUE (dotted key), got {item!r}", field="--set")
-        out[key.strip()] = yaml.safe_load(value)
-    return out
+    return parse_set_options(items)
+
+
+def _overrides(config_file: Path | None, items: list[str]) -> dict[str, Any]:
+    from hiconav.settings import load_settings_file
+
+    return {**(load_settings_file(config_file) if config_file else {}), **_parse_sets(items)}
 
 
 SOURCE_FILE = "source.json"
@@ -72,6 +72,7 @@ def eval(
     address: str | None = typer.Option(None, "--address", help="Ray cluster address (ray backend)."),
     runner: str = typer.Option("hiconav.mission:run_episode", "--runner", help="Episode runner import path module:function."),
     set_: list[str] | None = typer.Option(None, "--set", help="Extra settings override KEY=VALUE (dotted key), repeatable."),
+    config_file: Path | None = typer.Option(None, "--config", help="Settings YAML applied to every preset; --set wins."),
     stuck_window: int = typer.Option(50, "--stuck-window", min=1, help="Steps without progress that count as stuck."),
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show the progress bar."),
 ) -> None:
@@ -93,7 +94,7 @@ def eval(
         if path is not None and not Path(path).exists():
             raise DataError(f"file not found: {path}", file=str(path), field=option)
     presets = resolve_presets(preset)  # fail on a bad preset before building episodes
-    config = EvalConfig(runner=runner, presets=tuple(presets), overrides=_parse_sets(set_ or []), seed=seed,
+    config = EvalConfig(runner=runner, presets=tuple(presets), overrides=_overrides(config_file, set_ or []), seed=seed,
                         workers=workers, backend=backend, address=address, stuck_window=stuck_window,
                         progress=progress)
     n_workers = workers if workers is not None else (os.cpu_count() or 1)

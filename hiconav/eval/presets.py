@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import Any
 
 from hiconav.errors import ConfigError
+from hiconav.settings import nest  # noqa: F401  (re-exported: runners with nested settings use it)
 
 # Settings paths (owned by the exploration, memory and mission areas; hiconav/<area>/config.py):
 #   exploration.ordering.ordering   "wtrp" (the method) | "greedy_utility" | "nearest"
@@ -73,16 +74,3 @@ def overrides_for(preset: str, extra: dict[str, Any] | None = None) -> dict[str,
     return {**PRESETS[preset], **(extra or {})}
 
 
-def nest(overrides: dict[str, Any]) -> dict[str, Any]:
-    """``{"a.b": 1}`` -> ``{"a": {"b": 1}}`` (for runners whose settings are nested models)."""
-    out: dict[str, Any] = {}
-    for path, value in overrides.items():
-        node = out
-        parts = path.split(".")
-        for part in parts[:-1]:
-            child = node.setdefault(part, {})
-            if not isinstance(child, dict):
-                raise ConfigError(f"override {path!r} conflicts with a value at {part!r}", field=path)
-            node = child
-        node[parts[-1]] = value
-    return out

@@ -75,7 +75,7 @@ def test_set_values_are_parsed_as_yaml_and_bad_ones_rejected() -> None:
 
     assert _parse_sets(["exploration.lambda_vis=0.5", "mission.verify=false", "a.b=nearest"]) == {
         "exploration.lambda_vis": 0.5, "mission.verify": False, "a.b": "nearest"}
-    with pytest.raises(ConfigError, match="KEY=VALUE"):
+    with pytest.raises(ConfigError, match="area.key=value"):
         _parse_sets(["novalue"])
 
 
