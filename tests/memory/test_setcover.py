@@ -96,7 +96,7 @@ def test_solver_failure_gives_labelled_greedy_fallback(monkeypatch):
     def broken(*args, **kwargs):
         raise RuntimeError("solver crashed")
 
-    monkeypatch.setattr(sc, "milp", broken)
+    monkeypatch.setattr(sc, "_solve_mip", broken)
     res = solve_multicover(costs, A, req, reduce=False)
     assert res.status == "greedy-fallback" and res.is_fallback
     assert not res.proven_optimal
@@ -108,13 +108,8 @@ def test_time_out_without_incumbent_gives_labelled_fallback(monkeypatch):
     rng = np.random.default_rng(6)
     costs, A, req = random_instance(rng, 12, 10, 2)
 
-    class TimedOut:
-        x = None
-        status = 1
-        message = "Time limit reached"
-        mip_dual_bound = np.nan
-
-    monkeypatch.setattr(sc, "milp", lambda *a, **k: TimedOut())
+    timed_out = sc._MipOutcome(None, 1, "Time limit reached", None)
+    monkeypatch.setattr(sc, "_solve_mip", lambda *a, **k: timed_out)
     res = solve_multicover(costs, A, req, reduce=False)
     assert res.status == "greedy-fallback"
     assert not res.proven_optimal
@@ -141,13 +136,61 @@ def test_time_out_with_incumbent_is_reported_unproven(monkeypatch):
     A = sp.csr_matrix(np.array([[1, 1, 0], [0, 1, 1], [1, 0, 1]], float))
     req = multicover_requirements(A, 1)
 
-    class Incumbent:
-        x = np.array([1.0, 1.0, 0.0])  # feasible, cost 2 (optimum is 2 as well, but not proven)
-        status = 1
-        message = "Time limit reached"
-        mip_dual_bound = 1.5
-
-    monkeypatch.setattr(sc, "milp", lambda *a, **k: Incumbent())
+    # feasible, cost 2 (optimum is 2 as well, but not proven)
+    incumbent = sc._MipOutcome(np.array([1.0, 1.0, 0.0]), 1, "Time limit reached", 1.5)
+    monkeypatch.setattr(sc, "_solve_mip", lambda *a, **k: incumbent)
     res = solve_multicover(np.array([1.0, 1.0, 1.0]) + [0, 0, 0.5], A, req, reduce=False)
     assert res.status == "time-limit" and not res.proven_optimal and not res.is_fallback
     assert res.selected == (0, 1) and res.lower_bound == 1.5
+
+
+@pytest.mark.parametrize("r", [1, 2])
+def test_fractional_costs_equal_brute_force(r):
+    # non-integral costs: reduced-cost fixing must use delta = 0 (no "better by 1" slack)
+    rng = np.random.default_rng(300 + r)
+    for _ in range(10):
+        m, n = int(rng.integers(4, 10)), int(rng.integers(6, 13))
+        costs, A, req = random_instance(rng, m, n, r)
+        costs = costs * rng.uniform(0.5, 1.5, n)
+        res = solve_multicover(costs, A, req)
+        assert res.proven_optimal
+        assert res.cost == pytest.approx(brute_force(costs, A, req))
+        assert res.lower_bound <= res.cost + 1e-9
+
+
+def test_lagrangian_bound_from_lp_duals_is_a_lower_bound():
+    rng = np.random.default_rng(11)
+    for r in (1, 2):
+        costs, A, req = random_instance(rng, 8, 10, r)
+        u = sc._lp_duals(costs, A, req)
+        assert u is not None and np.all(u >= 0)
+        d = costs - A.T @ u
+        lag = float(req @ u + np.minimum(d, 0).sum())
+        assert lag <= brute_force(costs, A, req) + 1e-7
+
+
+def test_mip_backends_agree_and_reduced_cost_fixing_keeps_the_optimum(monkeypatch):
+    # mid-size instances where the heuristic rarely closes the gap, so fixing + MIP run
+    rng = np.random.default_rng(21)
+    instances = [random_instance(rng, 60, 80, r, density=0.08) for r in (1, 1, 2)]
+    with_highspy = [solve_multicover(*inst) for inst in instances]
+    plain = [solve_multicover(*inst, reduce=False) for inst in instances]
+    monkeypatch.setattr(sc, "highspy", None)  # scipy.optimize.milp backend
+    with_scipy = [solve_multicover(*inst) for inst in instances]
+    for inst, a, b, c in zip(instances, with_highspy, plain, with_scipy):
+        assert a.proven_optimal and b.proven_optimal and c.proven_optimal
+        assert a.cost == pytest.approx(b.cost) and c.cost == pytest.approx(b.cost)
+        assert is_feasible_cover(inst[1], inst[2], np.array(a.selected))
+
+
+def test_time_out_after_fixing_keeps_a_feasible_labelled_fallback(monkeypatch):
+    # reduce=True path (LP bound, heuristic incumbent, fixing) with a MIP that returns nothing
+    rng = np.random.default_rng(21)
+    costs, A, req = random_instance(rng, 60, 80, 1, density=0.08)
+    optimum = solve_multicover(costs, A, req).cost
+    timed_out = sc._MipOutcome(None, 1, "Time limit reached", None)
+    monkeypatch.setattr(sc, "_solve_mip", lambda *a, **k: timed_out)
+    res = solve_multicover(costs, A, req)
+    assert res.status == "greedy-fallback" and not res.proven_optimal
+    assert is_feasible_cover(A, req, np.array(res.selected))
+    assert res.lower_bound is not None and res.lower_bound <= optimum + 1e-9 <= res.cost + 1e-9
