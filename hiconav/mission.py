@@ -10,8 +10,8 @@ clock and can write a Rerun recording; ``run_command`` is ``hiconav run``.
 
 This module only wires and scores: every algorithm lives in its layer. It imports the actor
 package (and so pykka) lazily, inside the functions, so that importing ``hiconav`` stays pure.
-A layer that is not installed yet is replaced by a clearly labelled fallback and named in the
-result (``fallbacks``).
+Stand-ins are labelled wherever they show: the detector's name ("oracle" for the simulator's
+ground truth) and the reasoner ("offline" without a VLM) are part of every result.
 """
 
 from __future__ import annotations
@@ -67,8 +67,6 @@ class MissionConfig(BaseModel):
     parse_latency_s: float | None = Field(None, ge=0)
     max_time_s: float = Field(600.0, gt=0)  # clock seconds before the run is cut off
     prune_every: int = Field(20, ge=0)  # ILP anchor pruning every n integrations (0: never)
-    detector: str = "oracle"
-    embedder: str = "minilm"
     control_mode: str = Field("discrete", pattern="^(discrete|velocity)$")
     # user actors by import path "package.module:NodeClass" -> keyword arguments; each is a
     # hiconav.actors.Node subclass (e.g. "hiconav.actors.monitor:BatteryMonitorNode": {"capacity_s": 300})
@@ -99,16 +97,6 @@ class MissionParts:
     fallbacks: list[str] = field(default_factory=list)
 
 
-def _optional(module: str, name: str) -> Any:
-    import importlib
-
-    try:
-        return getattr(importlib.import_module(module), name)
-    except Exception as exc:  # not installed yet, or broken: the caller labels the fallback
-        log.warning("%s.%s unavailable: %s: %s", module, name, type(exc).__name__, exc)
-        return None
-
-
 def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
                   overrides: dict[str, Any] | None = None, tree: str | Path | None = None,
                   clock: str | None = None, embedder: Any = None, sim_config: Any = None,
@@ -135,44 +123,31 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     sim = Simulator(house, sim_cfg, seed=seed)
 
     # perception -------------------------------------------------------------------------------
-    if cfg.detector != "oracle":
-        raise ConfigError(f"detector {cfg.detector!r}: only the oracle detector is wired into missions",
-                          field="mission.detector")
-    from hiconav.perception import OracleDetector
+    from hiconav.perception.config import PerceptionConfig
+    from hiconav.perception.factory import build_detector, build_embedder
 
-    detector = OracleDetector(house.instance_categories, seed=seed)
+    perception_cfg: Any = area_config(PerceptionConfig, overrides, "perception")
+    detector = build_detector(perception_cfg, instance_categories=house.instance_categories, seed=seed)
     if embedder is None:
-        from hiconav.perception import get_embedder
-
-        embedder = get_embedder(cfg.embedder)
+        embedder = build_embedder(perception_cfg)
     similarity = embedder.similarity
 
     # memory -----------------------------------------------------------------------------------
     mapping_cfg = area_config(MappingConfig, overrides, "mapping")
-    occ_cfg = getattr(mapping_cfg, "occupancy", None)
-    grid = OccupancyGrid(occ_cfg) if occ_cfg is not None else OccupancyGrid()
-    fr_cfg = getattr(mapping_cfg, "frontiers", None) or getattr(mapping_cfg, "frontier", None)
-    tracker = FrontierTracker(fr_cfg) if fr_cfg is not None else FrontierTracker()
-    CMG = _optional("hiconav.memory", "CognitiveMemoryGraph")
-    MemoryConfig = _optional("hiconav.memory.config", "MemoryConfig")
-    cmg = None
-    prune_every = cfg.prune_every
-    if CMG is not None:
-        mem_cfg = area_config(MemoryConfig, overrides, "memory") if MemoryConfig is not None else None
-        if mem_cfg is not None and getattr(mem_cfg, "prune", True) is False:
-            prune_every = 0
-        cmg = CMG(mem_cfg, embedder=embedder)
-    else:
-        fallbacks.append("memory: no CognitiveMemoryGraph installed; memory snapshots are empty")
+    grid = OccupancyGrid(mapping_cfg.occupancy)  # type: ignore[attr-defined]
+    tracker = FrontierTracker(mapping_cfg.frontiers)  # type: ignore[attr-defined]
+    from hiconav.exploration import ExplorationPlanner
+    from hiconav.exploration.config import ExplorationConfig
+    from hiconav.memory import CognitiveMemoryGraph, decompose
+    from hiconav.memory.config import MemoryConfig
+    from hiconav.reasoning.reasoner import Reasoner
+
+    mem_cfg: Any = area_config(MemoryConfig, overrides, "memory")
+    prune_every = cfg.prune_every if mem_cfg.prune else 0
+    cmg = CognitiveMemoryGraph(mem_cfg, embedder=embedder)
 
     # exploration ------------------------------------------------------------------------------
-    Planner = _optional("hiconav.exploration", "ExplorationPlanner")
-    ExplorationConfig = _optional("hiconav.exploration.config", "ExplorationConfig")
-    planner = None
-    if Planner is not None:
-        planner = Planner(area_config(ExplorationConfig, overrides, "exploration") if ExplorationConfig else None)
-    else:
-        fallbacks.append("exploration: no ExplorationPlanner installed; nearest-frontier order (fallback)")
+    planner = ExplorationPlanner(area_config(ExplorationConfig, overrides, "exploration"))
 
     # reasoning --------------------------------------------------------------------------------
     from hiconav.reasoning.config import ReasoningConfig
@@ -180,8 +155,6 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
 
     r_cfg: Any = area_config(ReasoningConfig, overrides, "reasoning")
     use_vlm = r_cfg.use_vlm()
-    Reasoner = _optional("hiconav.reasoning.reasoner", "Reasoner")
-    decompose = _optional("hiconav.memory", "decompose")
     verifier = None
     if use_vlm:
         from hiconav.reasoning.verifier import VLMVerifier
@@ -192,8 +165,6 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
         from hiconav.reasoning.verifier import OfflineVerifier
 
         verifier = OfflineVerifier(r_cfg, similarity)
-    if decompose is None:
-        fallbacks.append("reasoning: no memory.decompose installed; no subgraph verification")
 
     def parse(text: str) -> Any:
         return decompose_instruction(text, r_cfg, similarity=similarity)
@@ -204,7 +175,7 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
                         velocity_dt=1.0 / rates.control)
     perception = PerceptionNode(detector, rate_hz=rates.perception)
     memory = MemoryNode(grid, cmg, rate_hz=rates.memory, prune_every=prune_every)
-    reasoning = ReasoningNode(parse=parse, make_reasoner=(lambda task: Reasoner(task, r_cfg)) if Reasoner else None,
+    reasoning = ReasoningNode(parse=parse, make_reasoner=lambda task: Reasoner(task, r_cfg),
                               verifier=verifier, decompose=decompose, similarity=similarity, k=r_cfg.k,
                               rate_hz=rates.reasoning, stepped=stepped, latency_s=cfg.vlm_latency_s,
                               parse_latency_s=cfg.parse_latency_s)
