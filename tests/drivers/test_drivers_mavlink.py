@@ -207,7 +207,8 @@ def test_vehicle_stops_within_half_a_second_of_link_loss(make_link):
     assert wait_until(lambda: driver.last_sent == (0.0, 0.0), 0.5)  # next setpoint tick
     # link back: still paused (latched) until resume()
     relay.restore()
-    assert wait_until(lambda: driver.health().link_ok, 2.0)
+    # resume needs a fresh pose as well as the link: wait for the next pose message, not a clock
+    assert wait_until(lambda: driver.health().link_ok and driver.health().pose_age_s < 0.25, 2.0)
     assert driver.health().paused
     driver.resume()
     assert driver.health().ok
