@@ -2,7 +2,8 @@
 
 Renders FRAMES_PER_HOUSE frames in each of several ProcTHOR and Gibson houses from seeded
 free-space poses (random yaw, some with camera tilt), prints per-house figures and ends with
-one JSON line: {"render_ms_median": ..., "width": 640, "height": 480}. Time per frame covers
+one JSON line: {"render_ms_median": ..., "width": 640, "height": 480, "cpu_ms_median": ...,
+"load_avg_1m": ...} (the load average says how contended the machine was). Time per frame covers
 the draw call and the read-back of all three images into fresh numpy arrays (wall clock). The
 per-house lines also give the process CPU time per frame summed over all threads (Mesa's
 llvmpipe renders on worker threads), which is less sensitive to other load on the machine.
@@ -15,6 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import time
 
 import numpy as np
@@ -35,10 +37,13 @@ def main() -> None:
     ap.add_argument("--houses", default=",".join(HOUSES))
     args = ap.parse_args()
     ctx = gl_context()
-    print(f"GL renderer: {ctx.info['GL_RENDERER']}")
+    print(f"GL renderer: {ctx.info['GL_RENDERER']}  LP_NUM_THREADS="
+          f"{os.environ.get('LP_NUM_THREADS', '(Mesa default: one per core)')}  "
+          f"load average (1 min) at start: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     K = CameraIntrinsics.from_hfov(W, H, 79.0)
     renderer = Renderer(W, H, min_depth=0.5, max_depth=5.0)
     all_ms: list[float] = []
+    all_cpu: list[float] = []
     for spec in args.houses.split(","):
         house = load_house(spec)
         renderer.set_house(house)
@@ -56,13 +61,15 @@ def main() -> None:
             ms.append((time.perf_counter() - t0) * 1000.0)
             cpu.append((time.process_time() - c0) * 1000.0)
         all_ms += ms
+        all_cpu += cpu
         print(f"{spec:22s} boxes={len(house.boxes):5d} frames={len(ms)} "
               f"median={np.median(ms):6.2f} ms p90={np.percentile(ms, 90):6.2f} ms "
               f"min={np.min(ms):6.2f} ms cpu(all threads)={np.median(cpu):6.2f} ms")
     renderer.release()
     print(f"total frames: {len(all_ms)}")
     print(json.dumps({"render_ms_median": round(float(np.median(all_ms)), 3), "width": W,
-                      "height": H}))
+                      "height": H, "cpu_ms_median": round(float(np.median(all_cpu)), 3),
+                      "load_avg_1m": round(os.getloadavg()[0], 2)}))
 
 
 if __name__ == "__main__":

@@ -326,6 +326,86 @@ def rasterize_polygon(shape: tuple[int, int], origin: np.ndarray, res: float,
     return out
 
 
+def triangulate_polygon(polygon: np.ndarray) -> np.ndarray:
+    """(T, 3) int vertex indices triangulating a simple polygon ((N, 2) world xy) by ear clipping.
+
+    Works for convex and concave polygons (ProcTHOR rooms are rectilinear, often L-shaped);
+    collinear corners are dropped. Triangles are counter-clockwise (seen from +z) whatever the
+    polygon's own orientation. Raises ValueError for self-intersecting or degenerate polygons.
+    O(N^3) worst case: meant for room outlines of tens of corners.
+    """
+    pts = np.asarray(polygon, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
+        raise ValueError(f"a polygon needs (N >= 3, 2) corners, got shape {pts.shape}")
+    idx = list(range(len(pts)))
+    if len(pts) > 3 and np.allclose(pts[0], pts[-1]):
+        idx.pop()  # closed ring: drop the repeated first corner
+    x, y = pts[:, 0], pts[:, 1]
+    area2 = float(np.sum(x[idx] * np.roll(y[idx], -1) - np.roll(x[idx], -1) * y[idx]))
+    if area2 < 0:
+        idx.reverse()  # make it counter-clockwise
+    eps = 1e-9 * max(1.0, float(np.abs(pts).max()) ** 2)
+
+    def cross(a: int, b: int, c: int) -> float:
+        return float((x[b] - x[a]) * (y[c] - y[a]) - (y[b] - y[a]) * (x[c] - x[a]))
+
+    tris: list[tuple[int, int, int]] = []
+    guard = 0
+    while len(idx) > 3:
+        n = len(idx)
+        for k in range(n):
+            a, b, c = idx[k - 1], idx[k], idx[(k + 1) % n]
+            turn = cross(a, b, c)
+            if abs(turn) <= eps:  # collinear corner: no area, drop it
+                idx.pop(k)
+                break
+            if turn < 0:  # reflex corner: not an ear
+                continue
+            # An ear holds no other corner inside or on its boundary.
+            blocked = False
+            for j in idx:
+                if j in (a, b, c) or (pts[j] == pts[a]).all() or (pts[j] == pts[b]).all() \
+                        or (pts[j] == pts[c]).all():
+                    continue
+                if cross(a, b, j) >= -eps and cross(b, c, j) >= -eps and cross(c, a, j) >= -eps:
+                    blocked = True
+                    break
+            if not blocked:
+                tris.append((a, b, c))
+                idx.pop(k)
+                break
+        else:
+            raise ValueError("polygon is not simple (no ear found): self-intersecting?")
+        guard += 1
+        if guard > 4 * len(pts):  # pragma: no cover - defensive
+            raise ValueError("ear clipping did not terminate")
+    if len(idx) == 3 and abs(cross(*idx)) > eps:
+        tris.append(tuple(idx))
+    if not tris:
+        raise ValueError("polygon has zero area")
+    return np.asarray(tris, dtype=np.int64)
+
+
+def floor_mask(house: House) -> np.ndarray:
+    """(H, W) bool cells of the house grid that have a floor (navigable or under an object).
+
+    The union of the room polygons where the house has rooms; otherwise (scanned houses) the
+    navigable cells plus every object footprint. Outside it there is no floor to render.
+    """
+    nav = house.nav
+    if house.rooms:
+        mask = np.zeros(nav.shape, dtype=bool)
+        for r in house.rooms:
+            mask |= rasterize_polygon(nav.shape, nav.origin, nav.resolution, r.polygon)
+        return mask
+    mask = np.array(nav.navigable, dtype=bool)
+    for o in house.objects:
+        cells = house.footprint(o.instance_id)
+        ok = nav.in_bounds(cells)
+        mask[cells[ok, 0], cells[ok, 1]] = True
+    return mask
+
+
 def runs_to_boxes(mask: np.ndarray, origin: np.ndarray, res: float, z0: float, z1: float,
                   color: tuple[float, float, float], instance_id: int = NO_INSTANCE,
                   material: str = "object") -> list[Box]:

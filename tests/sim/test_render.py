@@ -169,3 +169,96 @@ def test_a_simulator_driven_from_another_thread_still_renders():
     t.start()
     t.join()
     assert errors  # a Renderer refuses a foreign thread instead of returning blank images
+
+
+def _door_house():
+    """An L-shaped room (concave floor polygon) with a 1 m door in its exterior east wall."""
+    from hiconav.sim.house import Room, assemble_house
+
+    poly = np.array([[0, 0], [6, 0], [6, 6], [3, 6], [3, 8], [0, 8]], float)
+    walls = [Wall((0.0, 0.0), (6.0, 0.0), 2.5, 0.1),
+             Wall((6.0, 0.0), (6.0, 6.0), 2.5, 0.1, holes=((3.0, 4.0, 0.0, 2.0),)),
+             Wall((6.0, 6.0), (3.0, 6.0), 2.5, 0.1), Wall((3.0, 6.0), (3.0, 8.0), 2.5, 0.1),
+             Wall((3.0, 8.0), (0.0, 8.0), 2.5, 0.1), Wall((0.0, 8.0), (0.0, 0.0), 2.5, 0.1)]
+    return assemble_house("door", [Room("room|0", "LivingRoom", poly)], walls, []), poly
+
+
+def test_no_floor_or_ceiling_is_visible_beyond_an_exterior_door():
+    house, _ = _door_house()
+    pose = Pose2D(4.5, 3.5, 0.0)  # 1.5 m in front of the door (x = 6, y in [3, 4]), facing it
+    _rgb, depth, inst = _render(house, pose, max_depth=20.0)
+    T = camera_pose_from_base(pose, 0.88)
+    _v, _u, pts = _backproject(depth, T)
+    assert len(pts) > 10000
+    # Floor inside the room is rendered up to the wall line ...
+    floor = np.abs(pts[:, 2]) < 0.01
+    assert (floor & (pts[:, 0] > 5.5)).sum() > 500
+    # ... and nothing at all beyond the exterior wall: background (no depth, no instance).
+    assert not np.any(pts[:, 0] > 6.06), pts[pts[:, 0] > 6.06][:5]
+    # The door opening's lower part (a ray from the camera hits x = 7 at floor-ish height)
+    # shows background: depth 0 and instance -1.
+    view = np.linalg.inv(T)
+    pc = view[:3, :3] @ np.array([7.0, 3.5, 0.3]) + view[:3, 3]
+    uu, vv = int(K.fx * pc[0] / pc[2] + K.cx), int(K.fy * pc[1] / pc[2] + K.cy)
+    assert depth[vv, uu] == 0.0 and inst[vv, uu] == -1
+
+
+def test_floor_covers_exactly_the_concave_room_polygon():
+    from matplotlib.path import Path as MplPath
+
+    house, poly = _door_house()
+    for pose in (Pose2D(1.5, 1.0, math.radians(60)), Pose2D(1.5, 7.5, -math.radians(60))):
+        T = camera_pose_from_base(pose, 0.88, -math.radians(30))
+        _rgb, depth, _inst = _render(house, pose, tilt=-math.radians(30), max_depth=20.0)
+        _v, _u, pts = _backproject(depth, T)
+        floor = pts[np.abs(pts[:, 2]) < 0.01, :2]
+        assert len(floor) > 20000
+        # every floor point lies in the L (grown by the half wall thickness the walls hide)
+        assert MplPath(poly).contains_points(floor, radius=0.1).all() or \
+            MplPath(poly[::-1]).contains_points(floor, radius=0.1).all()
+
+
+def test_scanned_house_floor_is_only_over_floor_cells(shared_data):
+    """Gibson: rendered floor points lie on navigable cells, object footprints or next to them."""
+    from scipy import ndimage
+
+    from hiconav.sim.episodes import generate_episodes
+    from hiconav.sim.house import floor_mask
+    from hiconav.sim.houses import load_house
+
+    house = load_house("gibson:Allensville", shared_data)
+    allowed = ndimage.binary_dilation(floor_mask(house), np.ones((5, 5), bool))
+    r = Renderer(640, 480, max_depth=20.0)
+    r.set_house(house)
+    n = 0
+    try:
+        for ep in generate_episodes(house, 4, seed=5):
+            T = camera_pose_from_base(ep.start, 0.88, -math.radians(30))
+            _rgb, depth, _inst = r.render(T, K)
+            _v, _u, pts = _backproject(depth, T)
+            rc = house.nav.world_to_cell(pts[np.abs(pts[:, 2]) < 0.01, :2])
+            assert house.nav.in_bounds(rc).all()
+            assert allowed[rc[:, 0], rc[:, 1]].all()
+            n += len(rc)
+    finally:
+        r.release()
+    assert n > 20000
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_ear_clipping_covers_a_rectilinear_polygon_exactly(reverse):
+    from hiconav.sim.house import triangulate_polygon
+
+    # U shape with a collinear corner on the bottom edge; area 6*4 - 2*3 = 18
+    poly = np.array([[0, 0], [3, 0], [6, 0], [6, 4], [4, 4], [4, 1], [2, 1], [2, 4], [0, 4]],
+                    float)
+    poly = poly[::-1] if reverse else poly
+    t = poly[triangulate_polygon(poly)]
+    area = 0.5 * ((t[:, 1, 0] - t[:, 0, 0]) * (t[:, 2, 1] - t[:, 0, 1])
+                  - (t[:, 1, 1] - t[:, 0, 1]) * (t[:, 2, 0] - t[:, 0, 0]))
+    assert np.all(area > 0)  # counter-clockwise whatever the input orientation
+    assert area.sum() == pytest.approx(18.0)
+    centres = t.mean(axis=1)  # no triangle bridges the notch x in (2, 4), y > 1
+    assert not np.any((centres[:, 0] > 2) & (centres[:, 0] < 4) & (centres[:, 1] > 1))
+    with pytest.raises(ValueError):
+        triangulate_polygon(np.array([[0, 0], [1, 0], [2, 0]], float))
