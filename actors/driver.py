@@ -1,20 +1,34 @@
-"""DriverActor: the robot (here the built-in simulator) behind a Node.
+"""DriverActor: the robot (the built-in simulator, or a real robot behind
+``drivers.adapters.SimulatorFacade``) behind a Node.
 
 Executes the newest command (latest-wins; stale commands are dropped and counted), publishes the
 resulting frame to perception, and ends the episode on STOP, on the step limit, or on an
 emergency stop (zero command; further commands are ignored). It never decides anything.
+
+A robot with ``health()`` (a ``drivers.DriverHealth``: the MAVLink driver's failsafes) pauses the
+mission while ``health().paused`` (link or heartbeat lost, geofence, mode lost): commands are
+dropped (the driver already streams zero), no frames go out, a ``HealthAlert("driver_paused")``
+goes to the mission and the runtime, and every pause is kept in ``pauses``. When the failsafe
+clears (``resume()`` or a recoverable loss) a fresh frame restarts the pipeline.
+
+``lockstep`` (real-time robots, where a step takes a few hundred ms): a command computed before
+the newest frame went out is stale (control issued it on an older snapshot, e.g. when a new goal
+arrived while the robot was still moving) and is dropped (counted as ``dropped["stale"]``);
+executing it would leave every later command one frame behind the robot (the navigator then
+zig-zags and sees false "stuck" steps). The simulator's steps are instantaneous: off by default.
 """
 
 from __future__ import annotations
 
 import threading
+import time
 from typing import Any
 
 import numpy as np
 from hiconav.actors.node import Node
 from hiconav.actors.runtime import NodeActor
 
-from hiconav.messages import CommandMsg, EpisodeEnded, FrameMsg
+from hiconav.messages import CommandMsg, EpisodeEnded, FrameMsg, HealthAlert
 from hiconav.types import DiscreteAction, Pose2D, VelocityCommand
 
 
@@ -33,7 +47,8 @@ class DriverNode(Node):
 
     def __init__(self, sim: Any, start: Pose2D, *, rate_hz: float = 10.0, max_steps: int = 500,
                  velocity_dt: float = 0.1, frame_to: tuple[str, ...] = ("perception",),
-                 ended_to: tuple[str, ...] = ("runtime", "mission", "recorder")) -> None:
+                 ended_to: tuple[str, ...] = ("runtime", "mission", "recorder"),
+                 health_to: tuple[str, ...] = ("runtime", "mission"), lockstep: bool = False) -> None:
         super().__init__(rate_hz)
         self.sim = sim
         self.start_pose = start
@@ -41,6 +56,11 @@ class DriverNode(Node):
         self.velocity_dt = velocity_dt
         self.frame_to = frame_to
         self.ended_to = ended_to
+        self.health_to = health_to
+        self.lockstep = lockstep
+        self._frame_sent_at = -float("inf")  # runtime clock when the newest frame went out
+        self.paused = False
+        self.pauses: list[dict[str, Any]] = []  # {"start", "end" (None while paused), "reason"}
         self.ended: EpisodeEnded | None = None
         self.trajectory: list[tuple[float, float, float]] = []
         self.actions: list[str] = []
@@ -61,12 +81,43 @@ class DriverNode(Node):
             self.ended = EpisodeEnded(reason, int(self.sim.steps), now)
             self.emit(self.ended_to, self.ended)
 
+    def _check_health(self, now: float) -> bool:
+        """True while the robot's failsafe pauses the mission (robots without ``health``: never)."""
+        health = getattr(self.sim, "health", None)
+        if health is None:
+            return False
+        h = health()
+        if h.paused and not self.paused:
+            self.paused = True
+            reason = h.reason or h.failsafe
+            self.pauses.append({"start": now, "end": None, "reason": reason, "failsafe": h.failsafe})
+            self.emit(self.health_to, HealthAlert("driver_paused", f"mission paused: {reason}", now))
+        elif not h.paused and self.paused:
+            self.paused = False
+            self.pauses[-1]["end"] = now
+            self.emit(self.health_to, HealthAlert("driver_resumed", "mission resumed", now))
+            self._pending_frame = self.sim.observe()  # restart the pipeline from the current view
+        return self.paused
+
+    def _drop(self, slot: str) -> None:
+        self.stats.dropped[slot] = self.stats.dropped.get(slot, 0) + 1
+
     def tick(self, now: float) -> None:
+        t0 = time.perf_counter()
+        if self.ended is None and self._check_health(now):
+            if self.take(CommandMsg) is not None:  # the driver streams zero while paused
+                self._drop("paused")
+            return
         if self._pending_frame is not None:
             self.emit(self.frame_to, FrameMsg(self._pending_frame, int(self.sim.steps)))
             self._pending_frame = None
+            self._frame_sent_at = now
         cmd = self.take(CommandMsg)
         if cmd is None or self.ended is not None:
+            return
+        if (self.lockstep and cmd.action is not None and cmd.action is not DiscreteAction.STOP
+                and cmd.stamp < self._frame_sent_at):  # discrete only: velocity commands are continuous
+            self._drop("stale")
             return
         if cmd.action is not None:
             self.last_command = cmd.action
@@ -86,11 +137,18 @@ class DriverNode(Node):
             self._end("max_steps", now)
             return
         self.emit(self.frame_to, FrameMsg(frame, int(self.sim.steps)))
+        self._frame_sent_at = now + (time.perf_counter() - t0)  # the step took real time
 
     def emergency_stop(self, reason: str, now: float) -> None:
         """Zero command: nothing moves any more; the episode ends (reason 'emergency')."""
         self.last_command = VelocityCommand.zero(now)
         self.take(CommandMsg)
+        stop = getattr(self.sim, "stop", None)  # a real robot: zero setpoint now
+        if stop is not None:
+            try:
+                stop()
+            except Exception:  # the episode ends anyway; the driver's own failsafe zeroes too
+                pass
         self._end("emergency", now)
 
     def stop(self, now: float) -> None:

@@ -34,10 +34,12 @@ class SimRendererSource:
         self._lock = threading.Lock()
 
     @staticmethod
-    def from_house(spec: str, sim_config: Any = None, seed: int = 0) -> SimRendererSource:
+    def from_house(spec: Any, sim_config: Any = None, seed: int = 0) -> SimRendererSource:
+        """``spec``: a house spec (``procthor:val/3``, a path) or an already loaded ``House``."""
         from hiconav.sim import Simulator, load_house
 
-        return SimRendererSource(Simulator(load_house(spec), sim_config, seed))
+        house = load_house(spec) if isinstance(spec, str) else spec
+        return SimRendererSource(Simulator(house, sim_config, seed))
 
     def frame_at(self, pose: Pose2D, stamp: float) -> Frame | None:
         with self._lock:
@@ -112,7 +114,10 @@ class OpenCVCaptureSource:
 
 
 def make_frame_source(profile: RobotProfile, **options: Any) -> FrameSource | None:
-    """The frame source the profile's ``frames`` section names (None for ``source: none``)."""
+    """The frame source the profile's ``frames`` section names (None for ``source: none``).
+
+    Options: ``house`` (a spec or a loaded House; overrides ``frames.house``), ``sim_config``.
+    """
     f = profile.frames
     if f.source == "sim":
         from hiconav.sim import SimConfig

@@ -296,6 +296,12 @@ class MavlinkDriver:
             return self._pose
 
     @property
+    def pose_stamp(self) -> float | None:
+        """Driver-clock time (s) at which the newest pose arrived (None before the first)."""
+        with self._lock:
+            return self._pose_stamp
+
+    @property
     def mode(self) -> str | None:
         with self._lock:
             return self._mode

@@ -8,6 +8,11 @@ in start order. ``run_episode`` runs one episode on the stepped (virtual) clock 
 ``EpisodeRecord`` (the entry point of ``hiconav eval``); ``run_mission`` does the same on either
 clock and can write a Rerun recording; ``run_command`` is ``hiconav run``.
 
+With ``robot=`` (``hiconav run --driver mavlink``) the driver actor drives a real-time robot
+behind ``drivers.adapters.SimulatorFacade`` instead of the simulator; the mission then runs on
+the real-time clock only, and is scored from the house's ground truth at the robot's reported
+pose (the simulated vehicle runs the same house).
+
 This module only wires and scores: every algorithm lives in its layer. It imports the actor
 package (and so pykka) lazily, inside the functions, so that importing ``hiconav`` stays pure.
 Stand-ins are labelled wherever they show: the detector's name ("oracle" for the simulator's
@@ -100,8 +105,12 @@ class MissionParts:
 def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
                   overrides: dict[str, Any] | None = None, tree: str | Path | None = None,
                   clock: str | None = None, embedder: Any = None, sim_config: Any = None,
-                  record: str | Path | None = None, spawn: bool = False) -> MissionParts:
-    """Create the simulator and every layer for one mission; nodes are returned in start order."""
+                  record: str | Path | None = None, spawn: bool = False, robot: Any = None) -> MissionParts:
+    """Create the simulator and every layer for one mission; nodes are returned in start order.
+
+    ``robot``: a simulator-shaped real-time robot (``drivers.adapters.SimulatorFacade``) that the
+    driver actor drives instead of a new ``Simulator`` (real-time clock only).
+    """
     from hiconav.actors.control import ControlNode
     from hiconav.actors.driver import DriverNode
     from hiconav.actors.exploration import ExplorationNode
@@ -120,7 +129,10 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     stepped = clock == "stepped"
     fallbacks: list[str] = []
     sim_cfg = sim_config or area_config(SimConfig, overrides, "sim")
-    sim = Simulator(house, sim_cfg, seed=seed)
+    if robot is not None and stepped:
+        raise ConfigError("a live robot runs on the real-time clock: the stepped (virtual) clock cannot "
+                          "pause a vehicle between actor ticks; use --clock real", field="mission.clock")
+    sim = robot if robot is not None else Simulator(house, sim_cfg, seed=seed)
 
     # perception -------------------------------------------------------------------------------
     from hiconav.perception.config import PerceptionConfig
@@ -172,7 +184,7 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     rates = cfg.rates
     nav_cfg = area_config(NavigatorConfig, overrides, "planning")
     driver = DriverNode(sim, start, rate_hz=rates.driver, max_steps=sim_cfg.max_steps,
-                        velocity_dt=1.0 / rates.control)
+                        velocity_dt=1.0 / rates.control, lockstep=robot is not None)
     perception = PerceptionNode(detector, rate_hz=rates.perception)
     memory = MemoryNode(grid, cmg, rate_hz=rates.memory, prune_every=prune_every)
     reasoning = ReasoningNode(parse=parse, make_reasoner=lambda task: Reasoner(task, r_cfg),
@@ -227,14 +239,19 @@ class MissionResult:
     tree_history: list[Any]
     reasoning_events: list[dict[str, Any]]
     report: Any = None
+    pauses: list[dict[str, Any]] = field(default_factory=list)  # failsafe pauses of a live robot
+    driver: str = "sim"
 
     def summary(self) -> dict[str, Any]:
         m = self.metrics
-        return {"success": bool(m.success), "spl": round(float(m.spl), 4), "steps": int(m.steps),
+        out = {"success": bool(m.success), "spl": round(float(m.spl), 4), "steps": int(m.steps),
                 "dts": round(float(m.dts), 3), "path_length": round(float(m.path_length), 3),
                 "termination": self.termination, "mission": self.mission_status, "clock": self.clock,
                 "clock_s": round(self.clock_s, 2), "wall_s": round(self.wall_s, 2), "detector": self.detector,
                 "reasoner": self.reasoner, "failure": self.failure, "fallbacks": self.fallbacks}
+        if self.driver != "sim":
+            out.update({"driver": self.driver, "pauses": self.pauses})
+        return out
 
 
 def _termination(report: Any, parts: MissionParts) -> str:
@@ -253,25 +270,43 @@ def _termination(report: Any, parts: MissionParts) -> str:
 
 def run_mission(house: Any, episode: Any, *, seed: int = 0, overrides: dict[str, Any] | None = None,
                 tree: str | Path | None = None, clock: str | None = None, instruction: str | None = None,
-                record: str | Path | None = None, spawn: bool = False, embedder: Any = None) -> MissionResult:
-    """Run one episode (``hiconav.sim.episodes.Episode``) on the chosen clock and score it."""
+                record: str | Path | None = None, spawn: bool = False, embedder: Any = None,
+                robot: Any = None) -> MissionResult:
+    """Run one episode (``hiconav.sim.episodes.Episode``) on the chosen clock and score it.
+
+    ``robot``: a connected ``drivers.adapters.SimulatorFacade`` (e.g. over MAVLink) driven instead
+    of the simulator, on the real-time clock; ``episode.start`` should be the robot's pose. The
+    metrics then come from ``house``'s ground truth at the robot's reported pose. The robot is
+    closed (zero setpoint, link released) when the run ends, also on Ctrl-C.
+    """
     from hiconav.actors import TICK_ORDER, RealtimeRuntime, SteppedRuntime
     from hiconav.sim.metrics import EpisodeTracker
 
     overrides = dict(overrides or {})
     cfg: MissionConfig = area_config(MissionConfig, overrides, "mission")  # type: ignore[assignment]
-    clock = clock or cfg.clock
+    clock = clock or ("real" if robot is not None else cfg.clock)
     text = instruction or episode.instruction
-    parts = build_mission(house, episode.start, text, seed=seed, overrides=overrides, tree=tree, clock=clock,
-                          embedder=embedder, record=record, spawn=spawn)
+    try:
+        parts = build_mission(house, episode.start, text, seed=seed, overrides=overrides, tree=tree, clock=clock,
+                              embedder=embedder, record=record, spawn=spawn, robot=robot)
+    except BaseException:
+        if robot is not None:
+            robot.close()
+        raise
     for note in parts.fallbacks:
         log.warning("FALLBACK %s", note)
-    tracker = EpisodeTracker(parts.sim, episode)
+    if robot is None:
+        tracker: Any = EpisodeTracker(parts.sim, episode)
+    else:
+        tracker = _RobotTracker(house, episode, robot, area_config(_sim_config_cls(), overrides, "sim"))
     if clock == "stepped":
         runtime: Any = SteppedRuntime(parts.nodes, tick_order=TICK_ORDER)
     else:
         runtime = RealtimeRuntime(parts.nodes)
-    report = runtime.run(max_time=cfg.max_time_s)
+    if robot is None:
+        report = runtime.run(max_time=cfg.max_time_s)
+    else:
+        report = _run_robot(runtime, robot, cfg.max_time_s)
     metrics = tracker.finish()
     mission_status = parts.mission.finished.status if parts.mission.finished else "RUNNING"
     failure = None if report.failure is None else f"{report.failure.actor}: {report.failure.error}"
@@ -279,11 +314,62 @@ def run_mission(house: Any, episode: Any, *, seed: int = 0, overrides: dict[str,
                            report.wall_s, parts.detector_name, parts.reasoner_name, parts.fallbacks,
                            {k: v for k, v in report.stats.items()}, parts.driver.path, parts.mission.history,
                            parts.reasoning.events, report)
+    if robot is not None:
+        result.pauses = list(getattr(parts.driver, "pauses", []))
+        result.driver = str(getattr(robot, "name", "robot"))
     try:
         parts.sim.close()
     except Exception:  # closing the renderer must not hide the result
         pass
     return result
+
+
+def _sim_config_cls() -> type[BaseModel]:
+    from hiconav.sim import SimConfig
+
+    return SimConfig
+
+
+class _RobotTracker:
+    """Scores a mission driven on a real-time robot from the house's ground truth at the pose
+    the robot reports (success: STOP called within ``success_distance`` geodesic m of a goal)."""
+
+    def __init__(self, house: Any, episode: Any, robot: Any, sim_cfg: Any) -> None:
+        from hiconav.sim.geodesic import GoalDistance
+
+        self.episode = episode
+        self.robot = robot
+        self.config = sim_cfg
+        self.goal = GoalDistance(house, episode, radius=sim_cfg.robot_radius)
+
+    def finish(self) -> Any:
+        from hiconav.sim.metrics import episode_metrics
+
+        r = self.robot
+        return episode_metrics(self.episode, final_distance=self.goal.distance(r.pose.xy),
+                               path_length=float(r.path_length), steps=int(r.steps), stopped=bool(r.stopped),
+                               collisions=0, config=self.config)
+
+
+def _run_robot(runtime: Any, robot: Any, max_time: float) -> Any:
+    """``runtime.run`` for a live robot: on Ctrl-C send a zero setpoint, stop every actor, re-raise.
+
+    (The MAVLink driver's own SIGINT hook has already sent zero; this repeats it and makes sure
+    no actor thread keeps commanding the robot.)
+    """
+    try:
+        return runtime.run(max_time=max_time)
+    except KeyboardInterrupt:
+        try:
+            robot.stop()
+        finally:
+            for ref in reversed(list(getattr(runtime, "refs", {}).values())):
+                try:
+                    ref.stop(block=True, timeout=5.0)
+                except Exception:  # already dead or stuck: the robot is stopped either way
+                    pass
+            robot.close()
+        raise
 
 
 def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 0) -> Any:
@@ -324,6 +410,48 @@ def parts_max_steps(overrides: dict[str, Any] | None) -> int:
 
 
 # ------------------------------------------------------------------------------------- hiconav run
+def connect_robot(house: Any, episode: Any, profile: Any, url: str | None,
+                  overrides: dict[str, Any] | None = None, *, handle_signals: bool = True) -> tuple[Any, Any]:
+    """Connect and engage a MAVLink robot for ``hiconav run --driver mavlink``.
+
+    ``profile``: a ``RobotProfile``, a profile name or a YAML path; ``url`` overrides its
+    ``mavlink.url``. Frames are rendered in ``house`` at the vehicle's reported pose (the
+    profile's frame source). Returns ``(robot, episode)``: the ``SimulatorFacade`` and the episode
+    re-anchored at the vehicle's pose (a robot starts where it stands: same target and goals, the
+    shortest path recomputed from there).
+    """
+    from dataclasses import replace
+
+    from hiconav.drivers.adapters import open_mission_robot
+    from hiconav.drivers.profiles import RobotProfile, load_profile
+    from hiconav.sim.geodesic import GoalDistance
+
+    prof = profile if isinstance(profile, RobotProfile) else load_profile(profile)
+    sim_cfg: Any = area_config(_sim_config_cls(), dict(overrides or {}), "sim")
+    robot = open_mission_robot(prof, url=url, house=house, handle_signals=handle_signals)
+    try:
+        deadline = time.monotonic() + prof.mavlink.heartbeat_wait_s
+        while robot.driver.pose is None and time.monotonic() < deadline:  # pose follows the heartbeat
+            time.sleep(0.02)
+        pose = robot.driver.pose
+        if pose is None:
+            from hiconav.drivers.base import DriverError
+
+            raise DriverError(f"no pose from the vehicle on {robot.driver.url}", field="mavlink.url")
+        goal = GoalDistance(house, episode, radius=sim_cfg.robot_radius)
+        shortest = float(goal.distance(pose.xy))
+        if not math.isfinite(shortest):
+            from hiconav.errors import DataError
+
+            raise DataError(f"the vehicle at ({pose.x:.2f}, {pose.y:.2f}) cannot reach any {episode.target} "
+                            f"of {house.name}: is the vehicle running the same house (--house)?", field="house")
+    except BaseException:
+        robot.close()
+        raise
+    return robot, replace(episode, episode_id=f"{episode.episode_id}/mavlink", start=pose,
+                          geodesic_distance=shortest)
+
+
 def episode_for_instruction(house: Any, start: Pose2D, instruction: str, episode_id: str = "run") -> Any:
     """An Episode whose goals are every instance of the instruction's first target category."""
     from hiconav.errors import DataError
@@ -349,24 +477,40 @@ def run_command(
     out: Path | None = typer_option(None, "--out", help="Folder for result.json (created)."),
     record: Path | None = typer_option(None, "--record", help="Write a Rerun recording (.rrd) here."),
     spawn: bool = typer_option(False, "--spawn", help="Open a live Rerun viewer."),
-    clock: str = typer_option("stepped", "--clock", help="stepped (virtual time, reproducible) or real."),
+    clock: str | None = typer_option(None, "--clock", help="stepped (virtual time, reproducible; default with the sim) or real (default and only choice with --driver mavlink)."),
     mission: str = typer_option("objectnav", "--mission", help="Mission tree: a YAML file or a name."),
     settings: list[str] = typer_option([], "--set", help="Override a setting: area.key=value (repeatable)."),
     config_file: Path | None = typer_option(None, "--config", help="Settings YAML (sections sim, memory, ...); --set wins."),
+    driver: str = typer_option("sim", "--driver", help="sim (the built-in simulator) or mavlink (a vehicle over MAVLink, e.g. `hiconav vehicle`)."),
+    connect: str | None = typer_option(None, "--connect", help="MAVLink URL (udpin:127.0.0.1:14550, tcp:HOST:PORT, /dev/ttyACM0); default: the profile's."),
+    profile: str | None = typer_option(None, "--profile", help="Robot profile name (config/robots) or YAML path; --driver mavlink: default sim_vehicle."),
 ) -> None:
-    """Run one ObjectNav mission end to end in the built-in simulator and print the outcome."""
+    """Run one ObjectNav mission end to end (built-in simulator, or a MAVLink vehicle) and print the outcome."""
     import json
 
     import typer
 
     from hiconav.sim import generate_episodes, load_house
 
-    clock = {"realtime": "real", "real-time": "real"}.get(clock, clock)
-    if clock not in ("stepped", "real"):
-        raise ConfigError(f"--clock must be 'stepped' or 'real', got {clock!r}", field="clock")
+    if driver not in ("sim", "mavlink"):
+        raise ConfigError(f"--driver must be 'sim' or 'mavlink', got {driver!r}", field="driver")
+    if driver == "sim" and (connect is not None or profile is not None):
+        raise ConfigError("--connect and --profile need --driver mavlink", field="driver")
+    if clock is not None:
+        clock = {"realtime": "real", "real-time": "real"}.get(clock, clock)
+        if clock not in ("stepped", "real"):
+            raise ConfigError(f"--clock must be 'stepped' or 'real', got {clock!r}", field="clock")
     from hiconav.settings import resolve
 
     overrides = resolve(config_file, settings)  # validated: unknown keys and bad values name file:line
+    if driver == "mavlink":
+        forced = clock or nest(overrides).get("mission", {}).get("clock")
+        if forced == "stepped":
+            raise ConfigError("--driver mavlink runs on the real-time clock: a live vehicle keeps moving between "
+                              "actor ticks, so the stepped (virtual) clock makes no sense against it; drop "
+                              "--clock stepped / mission.clock=stepped (or use --clock real)", field="clock")
+        clock = "real"
+    clock = clock or area_config(MissionConfig, overrides, "mission").clock  # type: ignore[attr-defined]
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
     if record is not None:
@@ -374,12 +518,28 @@ def run_command(
     the_house = load_house(house)
     episodes = generate_episodes(the_house, episode + 1, seed=seed)
     ep = episodes[episode]
+    robot = None
+    if driver == "mavlink":
+        robot, ep = connect_robot(the_house, ep, profile or "sim_vehicle", connect, overrides)
+        typer.echo(f"connected to {robot.driver.url} (profile {robot.profile.name}, mode {robot.driver.mode}, "
+                   f"{'armed' if robot.driver.armed else 'disarmed'}); vehicle at {ep.start}; frames rendered in "
+                   f"{the_house.name} at the reported pose; Ctrl-C sends a zero setpoint")
     if instruction:
         ep = episode_for_instruction(the_house, ep.start, instruction, f"{ep.episode_id}/custom")
     typer.echo(f"house {the_house.name}, episode {ep.episode_id}: {ep.instruction!r} "
                f"(target {ep.target}, shortest path {ep.geodesic_distance:.2f} m), clock {clock}, mission {mission}")
-    result = run_mission(the_house, ep, seed=seed, overrides=overrides, tree=mission, clock=clock,
-                         instruction=instruction or ep.instruction, record=record, spawn=spawn)
+    try:
+        result = run_mission(the_house, ep, seed=seed, overrides=overrides, tree=mission, clock=clock,
+                             instruction=instruction or ep.instruction, record=record, spawn=spawn, robot=robot)
+    except KeyboardInterrupt:
+        if robot is None:
+            raise
+        typer.secho("interrupted: zero setpoint sent, actors stopped, link closed", fg=typer.colors.YELLOW, err=True)
+        raise typer.Exit(130) from None
+    for pause in result.pauses:
+        end = "still paused at the end" if pause["end"] is None else f"resumed at {pause['end']:.1f} s"
+        typer.secho(f"FAILSAFE: mission paused at {pause['start']:.1f} s ({pause['reason']}); {end}",
+                    fg=typer.colors.YELLOW, err=True)
     summary = result.summary()
     m = result.metrics
     typer.echo(f"success: {bool(m.success)}  SPL: {m.spl:.3f}  steps: {m.steps}  DTS: {m.dts:.2f} m  "
