@@ -22,7 +22,7 @@ def _expected_location(path: Path) -> str:
         name, line = match.group(1).rsplit(":", 1)
         return f"{path.parent / name}:{line}"
     lines = text.splitlines()
-    line = next(i + 1 for i, l in enumerate(lines) if "# <-" in l)
+    line = next(i + 1 for i, text in enumerate(lines) if "# <-" in text)
     return f"{path}:{line}"
 
 
