@@ -55,6 +55,9 @@ class ReasoningNode(Node):
         self.requests = 0
         self.events: list[dict[str, Any]] = []
         self._parse: ParseRequest | None = None
+        # decomposition of the last memory snapshot, reused while the graph's views are unchanged
+        self._decomposed: tuple[Any, Any, list] | None = None
+        self.decompose_reused = 0
         self.latest_wins(WorldSnapshot)
         self.on(ParseRequest, lambda m, now: setattr(self, "_parse", m))
         self.on(TaskMsg, self._on_task)
@@ -76,6 +79,18 @@ class ReasoningNode(Node):
             return max((configured or 0.0) - measured, 0.0)  # real time: the call already took `measured`
         return configured if configured is not None else measured
 
+    def _decompose(self, memory: Any) -> list:
+        """``decompose`` of ``memory`` for the current task, memoised: a memory snapshot whose object
+        and anchor views are the very same objects as the last one's (the graph shares unchanged
+        views; only its stamp moved) decomposes to the same subgraphs, so the last result is reused."""
+        last = self._decomposed
+        if (last is not None and last[1] is self.task and _same_views(last[0], memory)):
+            self.decompose_reused += 1
+            return list(last[2])
+        subgraphs = self.decompose(memory, self.task, self.similarity, k=self.k)
+        self._decomposed = (memory, self.task, list(subgraphs))
+        return subgraphs
+
     def tick(self, now: float) -> None:
         if now < self.busy_until - 1e-9:
             return  # the previous reply is not visible yet (stepped time)
@@ -94,7 +109,7 @@ class ReasoningNode(Node):
         if (snap is None or self.reasoner is None or self.verifier is None or self.decompose is None
                 or snap.memory is None or self.reasoner.done):
             return
-        subgraphs = self.decompose(snap.memory, self.task, self.similarity, k=self.k)
+        subgraphs = self._decompose(snap.memory)
         self.reasoner.update(subgraphs)
         subgraph = self.reasoner.next()
         if subgraph is None:
@@ -110,3 +125,13 @@ class ReasoningNode(Node):
         if result.found and result.hypothesis is not None:
             self.emit(("mission", "memory", "recorder"), HypothesisMsg(result.hypothesis, now + delay, now, "", result.detail,
                                                            str(getattr(subgraph, "kind", ""))), delay)
+
+
+def _same_views(a: Any, b: Any) -> bool:
+    """True when two memory snapshots hold the identical (``is``) object and anchor views in order."""
+    if a is b:
+        return True
+    ao, bo = tuple(getattr(a, "objects", ())), tuple(getattr(b, "objects", ()))
+    aa, ba = tuple(getattr(a, "anchors", ())), tuple(getattr(b, "anchors", ()))
+    return (len(ao) == len(bo) and len(aa) == len(ba) and all(x is y for x, y in zip(ao, bo))
+            and all(x is y for x, y in zip(aa, ba)))

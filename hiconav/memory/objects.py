@@ -115,11 +115,16 @@ def box_iou_many(bmin: np.ndarray, bmax: np.ndarray, mins: np.ndarray, maxs: np.
 
     mode "iou": intersection / union (paper); "overlap": intersection / smaller volume.
     """
+    # called for every observation against every node: np.maximum(x, 0) and explicit products
+    # give the same numbers as np.clip(x, 0, None) / np.prod(axis=1) at a fraction of the overhead
     a0, a1 = bmin - pad, bmax + pad
     b0, b1 = mins - pad, maxs + pad
-    inter = np.prod(np.clip(np.minimum(a1, b1) - np.maximum(a0, b0), 0.0, None), axis=1)
-    va = float(np.prod(np.clip(a1 - a0, 0.0, None)))
-    vb = np.prod(np.clip(b1 - b0, 0.0, None), axis=1)
+    e = np.maximum(np.minimum(a1, b1) - np.maximum(a0, b0), 0.0)
+    inter = e[:, 0] * e[:, 1] * e[:, 2]
+    ea = np.maximum(a1 - a0, 0.0)
+    va = float(ea[0] * ea[1] * ea[2])
+    eb = np.maximum(b1 - b0, 0.0)
+    vb = eb[:, 0] * eb[:, 1] * eb[:, 2]
     if mode == "overlap":
         den = np.minimum(va, vb)
     else:
@@ -139,7 +144,7 @@ def merge_scores(obs_min: np.ndarray, obs_max: np.ndarray, obs_feature: np.ndarr
     if len(mins) == 0:
         return np.zeros(0)
     s_g = box_iou_many(obs_min, obs_max, mins, maxs, cfg.box_padding, cfg.geometric)
-    s_s = np.clip(features @ obs_feature, 0.0, 1.0)
+    s_s = np.minimum(np.maximum(features @ obs_feature, 0.0), 1.0)  # = np.clip(., 0, 1), cheaper
     if obs_embedding is not None:
         for i, e in enumerate(embeddings):
             if e is not None and e.shape == obs_embedding.shape:

@@ -22,6 +22,7 @@ Pure function of a snapshot: must not modify the graph or call a VLM.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -59,7 +60,9 @@ class Subgraph:
         return tuple(o.id for o in self.objects)
 
 
+@functools.lru_cache(maxsize=4096)
 def _norm(label: str) -> str:
+    # memoised: called for every object and task word on every decomposition
     return "_".join(label.strip().lower().replace("-", " ").split())
 
 

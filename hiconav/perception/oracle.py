@@ -83,6 +83,12 @@ class OracleDetector:
         for k in self.instance_categories:
             if k >= 0:
                 self._is_object[k + 1] = True
+        # label k + 1 -> itself for object instances, else 0 (background); one extra 0 entry at the
+        # end so that np.take(..., mode="clip") sends out-of-range labels to the background
+        n_lab = self._is_object.size
+        self._label_lut = np.concatenate(
+            [np.where(self._is_object, np.arange(n_lab), 0), [0]]
+        ).astype(np.int32)
         c = self.config
         log.info(
             "OracleDetector in use (source='oracle'): detections come from the simulator's "
@@ -134,9 +140,8 @@ class OracleDetector:
         # find the objects on a 2x subsampled image (4x fewer pixels), then refine each box and mask
         # at full resolution inside its coarse box grown by the subsampling step
         step = 2
-        labels = inst[::step, ::step].astype(np.int32) + 1  # -1 (none) -> 0 (background)
-        labels[(labels < 0) | (labels >= self._is_object.size)] = 0
-        labels[~self._is_object[labels]] = 0
+        # instance k -> label k + 1; none (-1), non-objects and out-of-range ids -> 0 (background)
+        labels = self._label_lut.take(inst[::step, ::step].astype(np.int32) + 1, mode="clip")
         slices = ndimage.find_objects(labels)
         out: list[Detection] = []
         present: set[str] = set()

@@ -1,0 +1,66 @@
+"""ReasoningNode reuses the last decomposition while the memory's views are the very same objects."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from hiconav.actors.reasoning import ReasoningNode
+
+from hiconav.messages import WorldSnapshot
+from hiconav.types import Pose2D
+
+
+class _Reasoner:
+    done = False
+
+    def __init__(self) -> None:
+        self.updates: list[list] = []
+
+    def update(self, subgraphs: list) -> None:
+        self.updates.append(list(subgraphs))
+
+    def next(self) -> None:  # nothing to verify: the tick ends after the update
+        return None
+
+
+def _node() -> tuple[ReasoningNode, list, _Reasoner]:
+    calls: list = []
+    reasoner = _Reasoner()
+
+    def decompose(memory, task, similarity, k=5):
+        calls.append(memory)
+        return [("subgraph", len(calls))]
+
+    node = ReasoningNode(parse=lambda text: text, make_reasoner=lambda task: reasoner, verifier=object(),
+                         decompose=decompose, similarity=lambda a, b: 0.0)
+    node._set_task("find the bed")
+    return node, calls, reasoner
+
+
+def _tick(node: ReasoningNode, memory, t: float) -> None:
+    node.receive(WorldSnapshot(int(t * 10), t, Pose2D(0.0, 0.0, 0.0), None, memory), t)
+    node.run_tick(t)
+
+
+def test_same_views_reuse_the_decomposition_and_changed_views_recompute_it():
+    node, calls, reasoner = _node()
+    bed, chair, anchor = object(), object(), object()
+    _tick(node, SimpleNamespace(objects=(bed,), anchors=(anchor,), stamp=0.1), 0.1)
+    # a new snapshot object (new stamp) holding the identical views: decomposition reused
+    _tick(node, SimpleNamespace(objects=(bed,), anchors=(anchor,), stamp=0.2), 0.2)
+    assert len(calls) == 1 and node.decompose_reused == 1
+    assert reasoner.updates[0] == reasoner.updates[1] == [("subgraph", 1)]
+    # a changed view (new object) or a new task: decomposed again
+    _tick(node, SimpleNamespace(objects=(bed, chair), anchors=(anchor,), stamp=0.3), 0.3)
+    assert len(calls) == 2
+    node._set_task("find the chair")
+    _tick(node, SimpleNamespace(objects=(bed, chair), anchors=(anchor,), stamp=0.4), 0.4)
+    assert len(calls) == 3 and node.decompose_reused == 1
+    assert reasoner.updates[-1] == [("subgraph", 3)]
+
+
+def test_a_replaced_view_of_the_same_object_is_a_change():
+    node, calls, _ = _node()
+    _tick(node, SimpleNamespace(objects=(object(),), anchors=(), stamp=0.1), 0.1)
+    _tick(node, SimpleNamespace(objects=(object(),), anchors=(), stamp=0.2), 0.2)  # rebuilt view
+    assert len(calls) == 2 and node.decompose_reused == 0
