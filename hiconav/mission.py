@@ -68,7 +68,9 @@ class MissionConfig(BaseModel):
     rates: RatesConfig = Field(default_factory=RatesConfig)
     verify: bool = True
     use_memory_labels: bool = True  # candidates from memory labels as well as from hypotheses
-    vlm_latency_s: float | None = Field(None, ge=0)  # stepped: reply visible after this (None: measured)
+    # stepped: a reply becomes visible after this (None: the measured latency of a VLM; the offline
+    # reasoner then counts as instantaneous so that same-seed runs stay identical)
+    vlm_latency_s: float | None = Field(None, ge=0)
     parse_latency_s: float | None = Field(None, ge=0)
     max_time_s: float = Field(600.0, gt=0)  # clock seconds before the run is cut off
     prune_every: int = Field(20, ge=0)  # ILP anchor pruning every n integrations (0: never)
@@ -181,6 +183,13 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     def parse(text: str) -> Any:
         return decompose_instruction(text, r_cfg, similarity=similarity)
 
+    vlm_latency, parse_latency = cfg.vlm_latency_s, cfg.parse_latency_s
+    if stepped and not use_vlm:
+        # The offline reasoner is local computation whose wall time depends on the machine's load
+        # (a first MiniLM encode takes 0.1-1 s); used as virtual delay it would make same-seed runs
+        # differ. In stepped time it counts as instantaneous unless a latency is configured.
+        vlm_latency = 0.0 if vlm_latency is None else vlm_latency
+        parse_latency = 0.0 if parse_latency is None else parse_latency
     rates = cfg.rates
     nav_cfg = area_config(NavigatorConfig, overrides, "planning")
     driver = DriverNode(sim, start, rate_hz=rates.driver, max_steps=sim_cfg.max_steps,
@@ -189,8 +198,8 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     memory = MemoryNode(grid, cmg, rate_hz=rates.memory, prune_every=prune_every)
     reasoning = ReasoningNode(parse=parse, make_reasoner=lambda task: Reasoner(task, r_cfg),
                               verifier=verifier, decompose=decompose, similarity=similarity, k=r_cfg.k,
-                              rate_hz=rates.reasoning, stepped=stepped, latency_s=cfg.vlm_latency_s,
-                              parse_latency_s=cfg.parse_latency_s)
+                              rate_hz=rates.reasoning, stepped=stepped, latency_s=vlm_latency,
+                              parse_latency_s=parse_latency)
     exploration = ExplorationNode(tracker, planner, rate_hz=rates.exploration, similarity=similarity)
     control = ControlNode(Navigator(nav_cfg), rate_hz=rates.control, mode=cfg.control_mode,
                           velocity_dt=1.0 / rates.control)

@@ -149,3 +149,14 @@ def test_eval_runner_entry_point_returns_an_episode_record(shared_data, embedder
     assert record.steps <= 12 and record.max_steps == 12
     assert record.detector == "oracle" and record.reasoner == "offline"
     assert set(record.layer_frames) >= {"driver", "perception", "memory", "mission", "control"}
+
+
+def test_stepped_offline_reasoning_takes_no_measured_wall_time(house, episodes, embedder):
+    """Same seed, same metrics needs virtual delays that do not depend on the machine's load: the
+    offline reasoner's measured wall time must not become its stepped latency."""
+    parts = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder)
+    assert parts.reasoner_name == "offline"
+    assert parts.reasoning.latency_s == 0.0 and parts.reasoning.parse_latency_s == 0.0
+    configured = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder,
+                               overrides={"mission.vlm_latency_s": 2.0})
+    assert configured.reasoning.latency_s == 2.0
