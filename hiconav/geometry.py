@@ -238,3 +238,34 @@ def ray_cast_grid(
     first = np.argmax(hit, axis=1)
     dist = np.where(any_hit, ts[first], max_range_cells)
     return np.minimum(dist, max_range_cells)
+
+
+class GridFrame:
+    """Mixin: world <-> cell conversions for a grid with ``origin`` (2,), ``resolution`` and ``shape``.
+
+    Cell (row i, col j) covers x in [ox + j*res, ox + (j+1)*res) and y in [oy + i*res, ...): the
+    convention of every grid in the project (the simulator's navigable map, the occupancy grid).
+    """
+
+    origin: np.ndarray
+    resolution: float
+
+    def world_to_cell(self, xy: np.ndarray) -> np.ndarray:
+        """World xy (..., 2) metres -> int (..., 2) cells (row, col); may be outside the grid."""
+        xy = np.asarray(xy, dtype=np.float64)
+        col = np.floor((xy[..., 0] - self.origin[0]) / self.resolution)
+        row = np.floor((xy[..., 1] - self.origin[1]) / self.resolution)
+        return np.stack([row, col], axis=-1).astype(np.int64)
+
+    def cell_to_world(self, rc: np.ndarray) -> np.ndarray:
+        """Cells (..., 2) (row, col) -> world xy (..., 2) of the cell centres."""
+        rc = np.asarray(rc, dtype=np.float64)
+        x = self.origin[0] + (rc[..., 1] + 0.5) * self.resolution
+        y = self.origin[1] + (rc[..., 0] + 0.5) * self.resolution
+        return np.stack([x, y], axis=-1)
+
+    def in_bounds(self, rc: np.ndarray) -> np.ndarray:
+        """(...,) bool: the cells lie inside the grid."""
+        rc = np.asarray(rc)
+        h, w = self.shape  # type: ignore[attr-defined]
+        return (rc[..., 0] >= 0) & (rc[..., 0] < h) & (rc[..., 1] >= 0) & (rc[..., 1] < w)

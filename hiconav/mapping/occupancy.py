@@ -30,7 +30,7 @@ import numba
 import numpy as np
 
 from hiconav.errors import FrameError
-from hiconav.geometry import pixel_rays, validate_depth
+from hiconav.geometry import GridFrame, pixel_rays, validate_depth
 from hiconav.mapping.config import OccupancyConfig
 from hiconav.types import Frame, freeze
 
@@ -65,35 +65,8 @@ def disk_kernel(radius_cells: float) -> np.ndarray:
     return (xx * xx + yy * yy <= radius_cells * radius_cells + 1e-9).astype(np.uint8)
 
 
-class _GridFrame:
-    """Mixin: world <-> cell conversions for an object with ``origin`` (2,) and ``resolution``."""
-
-    origin: np.ndarray
-    resolution: float
-
-    def world_to_cell(self, xy: np.ndarray) -> np.ndarray:
-        """World xy (..., 2) metres -> int (..., 2) cells (row, col); may be outside the grid."""
-        xy = np.asarray(xy, dtype=np.float64)
-        col = np.floor((xy[..., 0] - self.origin[0]) / self.resolution)
-        row = np.floor((xy[..., 1] - self.origin[1]) / self.resolution)
-        return np.stack([row, col], axis=-1).astype(np.int64)
-
-    def cell_to_world(self, rc: np.ndarray) -> np.ndarray:
-        """Cells (..., 2) (row, col) -> world xy (..., 2) of the cell centres."""
-        rc = np.asarray(rc, dtype=np.float64)
-        x = self.origin[0] + (rc[..., 1] + 0.5) * self.resolution
-        y = self.origin[1] + (rc[..., 0] + 0.5) * self.resolution
-        return np.stack([x, y], axis=-1)
-
-    def in_bounds(self, rc: np.ndarray) -> np.ndarray:
-        """(...,) bool: the cells lie inside the grid."""
-        rc = np.asarray(rc)
-        h, w = self.shape  # type: ignore[attr-defined]
-        return (rc[..., 0] >= 0) & (rc[..., 0] < h) & (rc[..., 1] >= 0) & (rc[..., 1] < w)
-
-
 @dataclass(frozen=True)
-class GridSnapshot(_GridFrame):
+class GridSnapshot(GridFrame):
     """Read-only copy of the grid for other actors.
 
     state: (H, W) int8 (-1 unknown, 0 free, 1 occupied); inflated: (H, W) bool (occupied
@@ -141,7 +114,7 @@ class IntegrationStats:
     elapsed_ms: float
 
 
-class OccupancyGrid(_GridFrame):
+class OccupancyGrid(GridFrame):
     """Growing log-odds occupancy grid at ``config.resolution`` m per cell.
 
     Public attributes (read them, do not write them): state (H, W) int8 (-1 unknown, 0 free,

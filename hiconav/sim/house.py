@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hiconav.geometry import GridFrame
 from hiconav.types import freeze
 
 # Instance id of everything that is not an object (walls, floor, ceiling, background).
@@ -24,7 +25,7 @@ NO_INSTANCE = -1
 
 
 @dataclass(frozen=True)
-class NavGrid:
+class NavGrid(GridFrame):
     """Navigable floor at a fixed resolution (NOT inflated by the robot radius).
 
     navigable: (H, W) bool, True where the floor is free of walls and objects.
@@ -42,35 +43,6 @@ class NavGrid:
     @property
     def shape(self) -> tuple[int, int]:
         return (int(self.navigable.shape[0]), int(self.navigable.shape[1]))
-
-    def world_to_cell(self, xy: np.ndarray) -> np.ndarray:
-        """World xy (..., 2) metres -> integer cells (..., 2) as (row, col); may be outside."""
-        xy = np.asarray(xy, dtype=np.float64)
-        col = np.floor((xy[..., 0] - self.origin[0]) / self.resolution)
-        row = np.floor((xy[..., 1] - self.origin[1]) / self.resolution)
-        return np.stack([row, col], axis=-1).astype(np.int64)
-
-    def cell_to_world(self, rc: np.ndarray) -> np.ndarray:
-        """Cells (..., 2) (row, col) -> world xy (..., 2) of the cell centres (m)."""
-        rc = np.asarray(rc, dtype=np.float64)
-        x = self.origin[0] + (rc[..., 1] + 0.5) * self.resolution
-        y = self.origin[1] + (rc[..., 0] + 0.5) * self.resolution
-        return np.stack([x, y], axis=-1)
-
-    def in_bounds(self, rc: np.ndarray) -> np.ndarray:
-        """(..., 2) cells -> (...) bool, True inside the grid."""
-        rc = np.asarray(rc)
-        h, w = self.shape
-        return (rc[..., 0] >= 0) & (rc[..., 0] < h) & (rc[..., 1] >= 0) & (rc[..., 1] < w)
-
-    def is_navigable(self, xy: np.ndarray) -> np.ndarray:
-        """World xy (..., 2) -> (...) bool; outside the grid is not navigable."""
-        rc = self.world_to_cell(xy)
-        ok = self.in_bounds(rc)
-        h, w = self.shape
-        r = np.clip(rc[..., 0], 0, h - 1)
-        c = np.clip(rc[..., 1], 0, w - 1)
-        return ok & self.navigable[r, c]
 
 
 @dataclass(frozen=True)
