@@ -23,6 +23,7 @@ class ControlActor(NodeActor):
 
 class ControlNode(Node):
     name = "control"
+    event_driven = True  # per-frame chain: see Node.event_driven
     actor_class = ControlActor
 
     def __init__(self, navigator: Any, *, rate_hz: float = 10.0, mode: str = "discrete",

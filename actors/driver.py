@@ -48,7 +48,8 @@ class DriverNode(Node):
     def __init__(self, sim: Any, start: Pose2D, *, rate_hz: float = 10.0, max_steps: int = 500,
                  velocity_dt: float = 0.1, frame_to: tuple[str, ...] = ("perception",),
                  ended_to: tuple[str, ...] = ("runtime", "mission", "recorder"),
-                 health_to: tuple[str, ...] = ("runtime", "mission"), lockstep: bool = False) -> None:
+                 health_to: tuple[str, ...] = ("runtime", "mission"), lockstep: bool = False,
+                 stream: bool = False) -> None:
         super().__init__(rate_hz)
         self.sim = sim
         self.start_pose = start
@@ -58,6 +59,10 @@ class DriverNode(Node):
         self.ended_to = ended_to
         self.health_to = health_to
         self.lockstep = lockstep
+        # real time: the camera streams at the driver's rate whether or not a command arrived (the
+        # fast layer keeps mapping while the mission waits, e.g. for the VLM to parse the instruction)
+        self.stream = stream and not lockstep
+        self.streamed = 0
         self._frame_sent_at = -float("inf")  # runtime clock when the newest frame went out
         self.paused = False
         self.pauses: list[dict[str, Any]] = []  # {"start", "end" (None while paused), "reason"}
@@ -113,6 +118,11 @@ class DriverNode(Node):
             self._pending_frame = None
             self._frame_sent_at = now
         cmd = self.take(CommandMsg)
+        if cmd is None and self.stream and self.ended is None and now - self._frame_sent_at >= 0.9 * self.period:
+            self.emit(self.frame_to, FrameMsg(self.sim.observe(), int(self.sim.steps)))
+            self._frame_sent_at = now
+            self.streamed += 1
+            return
         if cmd is None or self.ended is not None:
             return
         if (self.lockstep and cmd.action is not None and cmd.action is not DiscreteAction.STOP

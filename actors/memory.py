@@ -22,6 +22,7 @@ class MemoryActor(NodeActor):
 
 class MemoryNode(Node):
     name = "memory"
+    event_driven = True  # per-frame chain: see Node.event_driven
     actor_class = MemoryActor
 
     def __init__(self, grid: Any, cmg: Any = None, *, rate_hz: float = 10.0, prune_every: int = 0,

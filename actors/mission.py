@@ -43,6 +43,7 @@ class MissionActor(NodeActor):
 
 class MissionNode(Node):
     name = "mission"
+    event_driven = True  # per-frame chain: see Node.event_driven
     actor_class = MissionActor
 
     def __init__(self, tree: str | Path, instruction: str, *, rate_hz: float = 10.0,

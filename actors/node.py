@@ -45,6 +45,10 @@ class Node:
     """Base class of the actor cores. Subclasses set ``name`` and register handlers by type."""
 
     name: str = "node"
+    #: real time only: work on new input at once instead of at the next timer tick. For the nodes
+    #: of the per-frame chain (perception, memory, control, mission), whose input arrives at the
+    #: driver's rate; heavy periodic nodes (exploration, reasoning) keep their own slower rate.
+    event_driven: bool = False
 
     def __init__(self, rate_hz: float) -> None:
         if rate_hz <= 0:

@@ -21,6 +21,7 @@ class PerceptionActor(NodeActor):
 
 class PerceptionNode(Node):
     name = "perception"
+    event_driven = True  # per-frame chain: see Node.event_driven
     actor_class = PerceptionActor
 
     def __init__(self, detector: Any, *, rate_hz: float = 10.0,

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import heapq
 import itertools
+import math
 import queue
 import threading
 import time
@@ -189,6 +190,8 @@ class NodeActor(pykka.ThreadingActor):
         self._tick_pending = threading.Event()
         self._ticker: threading.Thread | None = None
         self.dropped_ticks = 0
+        self.early_ticks = 0
+        self._last_tick = -math.inf
         self._timers: list[threading.Timer] = []
 
     def __str__(self) -> str:
@@ -227,7 +230,8 @@ class NodeActor(pykka.ThreadingActor):
         now = self.clock()
         if isinstance(message, Tick):
             self._tick_pending.clear()
-            self.node.run_tick(now)
+            if now - self._last_tick >= 0.5 * self.node.period:  # else an input tick just ran
+                self._run_tick(now)
         elif isinstance(message, _Go):
             self.routes = dict(message.routes)
             self._ticker = threading.Thread(target=self._tick_loop, name=f"ticker-{self.node.name}", daemon=True)
@@ -236,8 +240,19 @@ class NodeActor(pykka.ThreadingActor):
             self.node.emergency_stop(message.reason, now)
         else:
             self.node.receive(message, now)
+            # Nodes of the per-frame chain work on new input at once instead of at their next timer
+            # tick; otherwise every hop of the driver -> perception -> memory -> control loop adds up
+            # to one period of latency and the loop runs at a fraction of the driver's rate. The
+            # driver keeps its timer, so the loop never runs faster than the configured camera rate.
+            if self.node.event_driven:
+                self.early_ticks += 1
+                self._run_tick(now)
         self._route(self.node.drain())
         return None
+
+    def _run_tick(self, now: float) -> None:
+        self._last_tick = now
+        self.node.run_tick(now)
 
     # helpers ------------------------------------------------------------------------------------
     def _route(self, outs: list[Outgoing]) -> None:

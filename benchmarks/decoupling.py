@@ -9,7 +9,7 @@ memory -> control closed loop). Ends with one JSON line:
     {"fast_hz_no_vlm": ..., "fast_hz_with_vlm": ..., "ratio": ..., ...}
 
 Acceptance (issue #8): fast_hz_with_vlm >= 0.95 * fast_hz_no_vlm. The fast layer runs at a
-configured rate (``--rate``, default 4 Hz, 320x240 camera) below what the machine sustains, so
+configured rate (``--rate``, default 10 Hz as the perception actor, 640x480 camera), so
 that the figure shows whether the VLM steals time from it rather than how fast the CPU is; on a
 shared, busy machine both numbers still move with the load of other processes.
 
@@ -91,9 +91,9 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=30.0)
     parser.add_argument("--delay", type=float, default=2.0)
     parser.add_argument("--rounds", type=int, default=2, help="interleaved runs of each; medians are reported")
-    parser.add_argument("--rate", type=float, default=4.0,
+    parser.add_argument("--rate", type=float, default=10.0,
                         help="configured rate (Hz) of driver, perception, memory, mission and control")
-    parser.add_argument("--width", type=int, default=320, help="camera width (height = 3/4 of it)")
+    parser.add_argument("--width", type=int, default=640, help="camera width (height = 3/4 of it)")
     args = parser.parse_args()
     logging.basicConfig(level=logging.ERROR)
     from hiconav.perception import get_embedder

@@ -193,7 +193,8 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     rates = cfg.rates
     nav_cfg = area_config(NavigatorConfig, overrides, "planning")
     driver = DriverNode(sim, start, rate_hz=rates.driver, max_steps=sim_cfg.max_steps,
-                        velocity_dt=1.0 / rates.control, lockstep=robot is not None)
+                        velocity_dt=1.0 / rates.control, lockstep=robot is not None,
+                        stream=not stepped)
     perception = PerceptionNode(detector, rate_hz=rates.perception)
     memory = MemoryNode(grid, cmg, rate_hz=rates.memory, prune_every=prune_every)
     reasoning = ReasoningNode(parse=parse, make_reasoner=lambda task: Reasoner(task, r_cfg),

@@ -19,7 +19,7 @@ from hiconav.exploration.wtrp.common import WTRPError, WTRPSolution, check_insta
 MAX_EXACT_N = 18  # 2^18 * 18 float64 = 38 MB; auto uses exact up to 12 only
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _dp(M: np.ndarray, w: np.ndarray) -> np.ndarray:  # pragma: no cover - numba
     n = M.shape[0] - 1
     full = 1 << n

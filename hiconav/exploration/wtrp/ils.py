@@ -50,12 +50,12 @@ _EPS = 1e-9
 # ------------------------------------------------------------------------------------ kernels
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _seed(seed: int) -> None:  # pragma: no cover - numba
     np.random.seed(seed)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _build(s, M, w, pos, pre):  # pragma: no cover - numba
     """Fill the O(n) prefix data of solution s (positions 0..N-1, s[0] = depot).
 
@@ -81,7 +81,7 @@ def _build(s, M, w, pos, pre):  # pragma: no cover - numba
         pre[k + 1, 4] = pre[k, 4] + wk * pre[k, 1]
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always")
 def _cat(t1, c1, last1, s, M, pre, i, j):  # pragma: no cover - numba
     """Append segment (i, j) of s to an accumulated prefix (duration t1, latency c1, last node):
     forward s[i..j] if i <= j, else reversed s[i], s[i-1], ..., s[j]. Eq.: C(s1 + s2) =
@@ -98,7 +98,7 @@ def _cat(t1, c1, last1, s, M, pre, i, j):  # pragma: no cover - numba
     return d + t2, c1 + w2 * d + c2, s[j]
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always")
 def _eval_swap(s, M, pre, i, j):  # pragma: no cover - numba
     """Cost after swapping positions i < j."""
     n = s.shape[0] - 1
@@ -114,7 +114,7 @@ def _eval_swap(s, M, pre, i, j):  # pragma: no cover - numba
     return c
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always")
 def _eval_2opt(s, M, pre, i, j):  # pragma: no cover - numba
     """Cost after reversing positions i..j (i < j)."""
     n = s.shape[0] - 1
@@ -125,7 +125,7 @@ def _eval_2opt(s, M, pre, i, j):  # pragma: no cover - numba
     return c
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always")
 def _eval_oropt(s, M, pre, i, e, p):  # pragma: no cover - numba
     """Cost after moving block i..e between positions p and p+1 (p < i-1 or p > e)."""
     n = s.shape[0] - 1
@@ -144,7 +144,7 @@ def _eval_oropt(s, M, pre, i, e, p):  # pragma: no cover - numba
     return c
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always")
 def _activate(s, active, a, b):  # pragma: no cover - numba
     """Mark the nodes at positions a..b (clipped) active (don't-look bits off)."""
     n = s.shape[0] - 1
@@ -152,7 +152,7 @@ def _activate(s, active, a, b):  # pragma: no cover - numba
         active[s[p]] = True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _best_swap(s, M, pre, pos, nbr, full, active):  # pragma: no cover - numba
     N = s.shape[0]
     n = N - 1
@@ -188,7 +188,7 @@ def _best_swap(s, M, pre, pos, nbr, full, active):  # pragma: no cover - numba
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _best_2opt(s, M, pre, pos, nbr, full, active):  # pragma: no cover - numba
     N = s.shape[0]
     n = N - 1
@@ -226,7 +226,7 @@ def _best_2opt(s, M, pre, pos, nbr, full, active):  # pragma: no cover - numba
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _best_oropt(s, M, pre, pos, nbr, full, k, active):  # pragma: no cover - numba
     """Move block s[i .. i+k-1] between positions p and p+1 (p outside the block)."""
     N = s.shape[0]
@@ -273,7 +273,7 @@ def _best_oropt(s, M, pre, pos, nbr, full, k, active):  # pragma: no cover - num
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _rvnd(s, M, w, pos, pre, nbr, full, active):  # pragma: no cover - numba
     """Random variable neighbourhood descent; returns the final cost (s modified in place).
 
@@ -309,7 +309,7 @@ def _rvnd(s, M, w, pos, pre, nbr, full, active):  # pragma: no cover - numba
     return pre[n + 1, 3]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _construct(M, w, alpha):  # pragma: no cover - numba
     """Randomized greedy: pick among the ceil(alpha |CL|) best candidates by M[cur, c] / w_c."""
     N = M.shape[0]
@@ -333,7 +333,7 @@ def _construct(M, w, alpha):  # pragma: no cover - numba
     return s
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _double_bridge(s, lmax, active):  # pragma: no cover - numba
     """Exchange two random non-overlapping segments of lengths in [1, lmax]; activate the nodes
     around the new junctions."""
@@ -366,7 +366,7 @@ def _double_bridge(s, lmax, active):  # pragma: no cover - numba
     return out
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _ils_chunk(M, w, best, best_cost, cur, cur_cost, no_improve, max_no_improve, iters, pos, pre, nbr, full,
                lmax, active, dont_look, accept):  # pragma: no cover - numba
     """Up to ``iters`` ILS iterations: perturb the current solution ``cur``, descend, keep the
@@ -394,7 +394,7 @@ def _ils_chunk(M, w, best, best_cost, cur, cur_cost, no_improve, max_no_improve,
     return best_cost, cur_cost, no_improve, done
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _start(M, w, alpha, pos, pre, nbr, full, active):  # pragma: no cover - numba
     s = _construct(M, w, alpha)
     active[:] = True
