@@ -112,7 +112,10 @@ class Verifier(Protocol):
 
 
 def _not_found(subgraph: Any, source: str, reason: str, detail: str, latency: float) -> VerifyResult:
-    level = logging.INFO if reason in (replies.NOT_VISIBLE, NO_MATCH) else logging.WARNING
+    # a VLM reply that was rejected (malformed, out of range, late...) is worth a warning; "not there
+    # yet" answers, and every answer of the offline verifier, are the normal course of a search
+    normal = reason in (replies.NOT_VISIBLE, NO_MATCH) or source != "vlm"
+    level = logging.INFO if normal else logging.WARNING
     log.log(level, "%s verifier: not found (%s): %s", source, reason, detail[:300])
     signature = tuple(getattr(subgraph, "signature", ()))
     return VerifyResult(False, None, reason, detail, latency, source, signature)
