@@ -343,6 +343,7 @@ class Approach(_GoToObject):
         self._seq = None
         self._excluded: list[np.ndarray] = []
         self._attempts = 0
+        self._turned = False
 
     def _done(self, cand: Candidate) -> bool:
         pose = self.context.pose
@@ -366,14 +367,26 @@ class Approach(_GoToObject):
             return Status.FAILURE
         state = "pending" if self._seq is None else ctx.nav_state(self._seq)
         if self._seq is None or state in ("failed", "reached"):
-            if self._seq is not None:
+            if self._seq is not None and getattr(self, "_cell", None) is not None:
                 self._excluded.append(self._cell)
             self._attempts += 1
-            if self._attempts > self.param("max_attempts") or \
-                    not self._send(cand, max(self.param("distance") - 0.25, 0.2)):
-                if ctx.grid is not None and ctx.pose is not None:
-                    self.feedback_message = "no reachable approach cell"
-                    return Status.FAILURE
+            distance = self.param("distance")
+            # aim well inside the distance first; near walls and furniture the inflated map may only
+            # have free cells farther out, so widen the ring up to the distance itself
+            sent = self._attempts <= self.param("max_attempts") and any(
+                self._send(cand, d) for d in (max(distance - 0.25, 0.2), max(distance - 0.1, 0.2), distance))
+            if not sent and ctx.pose is not None and \
+                    ctx.distance_to_box(cand.box_min, cand.box_max) <= distance and not self._turned:
+                # already close but not facing it: turn in place toward the target
+                pose = ctx.pose
+                self._turned = True
+                self._cell = None
+                self._seq = ctx.send_goal(Goal(pose.x, pose.y, _facing(np.array([pose.x, pose.y]), cand.center),
+                                               0.5, "look", cand.object_id))
+                sent = True
+            if not sent and ctx.grid is not None and ctx.pose is not None:
+                self.feedback_message = "no reachable approach cell"
+                return Status.FAILURE
         self.feedback_message = f"approaching {cand.label} #{cand.object_id}"
         return Status.RUNNING
 
