@@ -35,6 +35,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import dijkstra
 
 from hiconav.exploration.config import CostConfig
+from hiconav.mapping.frontiers import nearest_reachable_cell
 from hiconav.types import Frontier, wrap_angle
 
 UNKNOWN = -1
@@ -116,25 +117,6 @@ def _grid_graph(mask: np.ndarray, step: float) -> tuple[sp.csr_matrix, np.ndarra
     return g, node
 
 
-def _snap(mask: np.ndarray, rc: np.ndarray, radius: int) -> tuple[int, int] | None:
-    """Nearest True cell of mask to rc (row, col) within ``radius`` cells (Euclidean)."""
-    H, W = mask.shape
-    r, c = int(rc[0]), int(rc[1])
-    if 0 <= r < H and 0 <= c < W and mask[r, c]:
-        return r, c
-    r0, r1, c0, c1 = max(0, r - radius), min(H, r + radius + 1), max(0, c - radius), min(W, c + radius + 1)
-    if r0 >= r1 or c0 >= c1:
-        return None
-    rr, cc = np.nonzero(mask[r0:r1, c0:c1])
-    if rr.size == 0:
-        return None
-    d2 = (rr + r0 - r) ** 2 + (cc + c0 - c) ** 2
-    k = int(np.argmin(d2))
-    if d2[k] > radius * radius:
-        return None
-    return int(rr[k] + r0), int(cc[k] + c0)
-
-
 def geodesic_distances(grid: GridLike, points_xy: np.ndarray, config: CostConfig | None = None) -> np.ndarray:
     """(k, k) geodesic metres between world points (k, 2) on the traversable grid; inf when
     unreachable or off the grid. One Dijkstra call with all k sources (see module docstring)."""
@@ -151,7 +133,7 @@ def geodesic_distances(grid: GridLike, points_xy: np.ndarray, config: CostConfig
     radius = math.ceil(cfg.snap_radius_m / (s * grid.resolution))
     src = np.full(k, -1, dtype=np.int64)
     for i in range(k):
-        cell = _snap(coarse, rc[i], radius)
+        cell = nearest_reachable_cell(coarse, rc[i], radius)
         if cell is not None:
             src[i] = node[cell]
     valid = np.flatnonzero(src >= 0)
