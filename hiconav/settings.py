@@ -31,7 +31,8 @@ AREAS: dict[str, str] = {
     "mission": "hiconav.mission:MissionConfig",
 }
 
-DEFAULT_FILE = Path(__file__).resolve().parent.parent / "config" / "default.yaml"
+#: shipped as package data of ``hiconav.config`` (the top-level config/ folder in a checkout)
+DEFAULT_FILE = Path(importlib.import_module("hiconav.config").__file__).resolve().parent / "default.yaml"
 
 
 def area_model(area: str) -> type[BaseModel]:
