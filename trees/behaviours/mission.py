@@ -336,6 +336,8 @@ class Approach(_GoToObject):
         "facing_tolerance_deg": Param(float, 35.0, minimum=1.0, maximum=180.0),
         "max_attempts": Param(int, 4, minimum=1, maximum=50),
         "timeout_s": Param(float, 120.0, minimum=0.1, maximum=3600.0),
+        "max_distance": Param(float, 1.5, minimum=0.1, maximum=5.0,
+                              doc="settle this far at most when nothing closer is reachable"),
     }
 
     def initialise(self) -> None:
@@ -344,12 +346,13 @@ class Approach(_GoToObject):
         self._excluded: list[np.ndarray] = []
         self._attempts = 0
         self._turned = False
+        self._ring = 0.0  # the approach ring the current goal came from (m)
 
     def _done(self, cand: Candidate) -> bool:
         pose = self.context.pose
         if pose is None:
             return False
-        close = self.context.distance_to_box(cand.box_min, cand.box_max) <= self.param("distance")
+        close = self.context.distance_to_box(cand.box_min, cand.box_max) <= max(self.param("distance"), self._ring)
         err = abs(wrap_angle(_facing(np.array([pose.x, pose.y]), cand.center) - pose.yaw))
         return close and math.degrees(err) <= self.param("facing_tolerance_deg")
 
@@ -373,8 +376,17 @@ class Approach(_GoToObject):
             distance = self.param("distance")
             # aim well inside the distance first; near walls and furniture the inflated map may only
             # have free cells farther out, so widen the ring up to the distance itself
-            sent = self._attempts <= self.param("max_attempts") and any(
-                self._send(cand, d) for d in (max(distance - 0.25, 0.2), max(distance - 0.1, 0.2), distance))
+            rings = [max(distance - 0.25, 0.2), max(distance - 0.1, 0.2), distance]
+            # furniture in front of the target (a sofa under a wall-mounted tv) can leave no free cell
+            # within the distance: then settle for the closest ring that has one, up to max_distance,
+            # and stop there rather than give up (the success check is the judge, not this estimate)
+            rings += [r for r in (1.0, 1.25, 1.5, 2.0) if distance < r <= self.param("max_distance")]
+            sent = False
+            if self._attempts <= self.param("max_attempts"):
+                for ring in rings:
+                    if self._send(cand, ring):
+                        self._ring, sent = ring, True
+                        break
             if not sent and ctx.pose is not None and \
                     ctx.distance_to_box(cand.box_min, cand.box_max) <= distance and not self._turned:
                 # already close but not facing it: turn in place toward the target
