@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import signal
 import subprocess
+import time
 import sys
 
 from driver_helpers import free_udp_port, test_profile, wait_until
@@ -27,7 +28,8 @@ def test_vehicle_command_serves_a_px4_vehicle():
         assert driver.pose.distance_to(type(driver.pose)(1.0, 2.0, 0.0)) < 1e-3
         driver.engage()
         assert driver.mode == "OFFBOARD"
-        for _ in range(20):
+        deadline = time.monotonic() + 5.0  # the vehicle is another process: allow for a loaded machine
+        while time.monotonic() < deadline:
             driver.send(VelocityCommand(0.5, 0.0))
             if driver.pose.x > 1.05:
                 break
