@@ -28,7 +28,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 import scipy.sparse as sp
@@ -36,20 +35,12 @@ from scipy.sparse.csgraph import dijkstra
 
 from hiconav.exploration.config import CostConfig
 from hiconav.mapping.frontiers import nearest_reachable_cell
+from hiconav.mapping.occupancy import GridLike
 from hiconav.types import Frontier, wrap_angle
 
 UNKNOWN = -1
 
 
-class GridLike(Protocol):
-    """What the cost model needs of the fast layer's OccupancyGrid / GridSnapshot."""
-
-    state: np.ndarray  # (H, W) int8: -1 unknown, 0 free, 1 occupied
-    inflated: np.ndarray  # (H, W) bool: occupied dilated by the robot radius
-    origin: np.ndarray  # (2,) world xy of the corner of cell (0, 0)
-    resolution: float  # m per cell
-
-    def world_to_cell(self, xy: np.ndarray) -> np.ndarray: ...
 
 
 @dataclass(frozen=True)

@@ -13,11 +13,11 @@ It must not score or order frontiers (that is exploration's job) and must not mo
 from __future__ import annotations
 
 import math
-from typing import Protocol
 
 import cv2
 import numpy as np
 
+from hiconav.mapping.occupancy import GridLike
 from hiconav.mapping.config import FrontierConfig
 from hiconav.types import Frontier
 
@@ -27,14 +27,6 @@ _CROSS = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], dtype=np.uint8)
 _KEY_OFFSET = 1 << 30
 
 
-class _Grid(Protocol):
-    state: np.ndarray
-    inflated: np.ndarray
-    origin: np.ndarray
-    resolution: float
-
-    def world_to_cell(self, xy: np.ndarray) -> np.ndarray: ...
-    def cell_to_world(self, rc: np.ndarray) -> np.ndarray: ...
 
 
 def frontier_mask(state: np.ndarray) -> np.ndarray:
@@ -107,7 +99,7 @@ class FrontierTracker:
         order = np.argsort(x @ vt[0], kind="stable")
         return [cells[idx] for idx in np.array_split(order, k)]
 
-    def update(self, grid: _Grid, robot_xy: np.ndarray) -> list[Frontier]:
+    def update(self, grid: GridLike, robot_xy: np.ndarray) -> list[Frontier]:
         """Frontiers of ``grid`` (an OccupancyGrid or GridSnapshot) seen from ``robot_xy`` (2,) world m.
 
         Returns hiconav.types.Frontier objects sorted by id; ``cells`` are (row, col) in

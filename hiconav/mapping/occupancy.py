@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Protocol
 from dataclasses import dataclass
 
 import cv2
@@ -65,8 +66,42 @@ def disk_kernel(radius_cells: float) -> np.ndarray:
     return (xx * xx + yy * yy <= radius_cells * radius_cells + 1e-9).astype(np.uint8)
 
 
+class GridLike(Protocol):
+    """What consumers (frontiers, planning, exploration costs) need of an OccupancyGrid / GridSnapshot."""
+
+    state: np.ndarray  # (H, W) int8: -1 unknown, 0 free, 1 occupied
+    inflated: np.ndarray  # (H, W) bool: occupied dilated by the robot radius
+    origin: np.ndarray  # (2,) world xy of the corner of cell (0, 0)
+    resolution: float  # m per cell
+
+    def world_to_cell(self, xy: np.ndarray) -> np.ndarray: ...
+    def cell_to_world(self, rc: np.ndarray) -> np.ndarray: ...
+
+
+class _OccupancyFields(GridFrame):
+    """Properties shared by the live grid and its snapshots (both hold state/explored arrays)."""
+
+    state: np.ndarray
+    explored: np.ndarray
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.state.shape  # type: ignore[return-value]
+
+    @property
+    def origin_cells(self) -> np.ndarray:
+        """(2,) int (row, col) offset of this grid in the global cell lattice (origin / res)."""
+        return np.array(
+            [round(self.origin[1] / self.resolution), round(self.origin[0] / self.resolution)], dtype=np.int64
+        )
+
+    @property
+    def explored_area_m2(self) -> float:
+        return float(np.count_nonzero(self.explored)) * self.resolution**2
+
+
 @dataclass(frozen=True)
-class GridSnapshot(GridFrame):
+class GridSnapshot(_OccupancyFields):
     """Read-only copy of the grid for other actors.
 
     state: (H, W) int8 (-1 unknown, 0 free, 1 occupied); inflated: (H, W) bool (occupied
@@ -86,20 +121,6 @@ class GridSnapshot(GridFrame):
         for name in ("state", "inflated", "explored", "origin"):
             freeze(getattr(self, name))
 
-    @property
-    def shape(self) -> tuple[int, int]:
-        return self.state.shape  # type: ignore[return-value]
-
-    @property
-    def origin_cells(self) -> np.ndarray:
-        """(2,) int (row, col) offset of this grid in the global cell lattice (origin / res)."""
-        return np.array(
-            [round(self.origin[1] / self.resolution), round(self.origin[0] / self.resolution)], dtype=np.int64
-        )
-
-    @property
-    def explored_area_m2(self) -> float:
-        return float(np.count_nonzero(self.explored)) * self.resolution**2
 
 
 @dataclass(frozen=True)
@@ -114,7 +135,7 @@ class IntegrationStats:
     elapsed_ms: float
 
 
-class OccupancyGrid(GridFrame):
+class OccupancyGrid(_OccupancyFields):
     """Growing log-odds occupancy grid at ``config.resolution`` m per cell.
 
     Public attributes (read them, do not write them): state (H, W) int8 (-1 unknown, 0 free,
@@ -140,20 +161,6 @@ class OccupancyGrid(GridFrame):
         self._footprint = disk_kernel(0.8 * c.robot_radius / self.resolution).astype(bool)
 
     # ------------------------------------------------------------------ grid geometry
-    @property
-    def shape(self) -> tuple[int, int]:
-        return self.state.shape  # type: ignore[return-value]
-
-    @property
-    def origin_cells(self) -> np.ndarray:
-        """(2,) int (row, col) offset of this grid in the global cell lattice (origin / res)."""
-        return np.array(
-            [round(self.origin[1] / self.resolution), round(self.origin[0] / self.resolution)], dtype=np.int64
-        )
-
-    @property
-    def explored_area_m2(self) -> float:
-        return float(np.count_nonzero(self.explored)) * self.resolution**2
 
     def _ensure_bounds(self, xmin: float, ymin: float, xmax: float, ymax: float) -> bool:
         """Grow the grid so that it covers [xmin, xmax] x [ymin, ymax]; True if it grew."""

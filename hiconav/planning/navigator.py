@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Protocol
 
 import cv2
 import numpy as np
 
+from hiconav.mapping.occupancy import GridLike
 from hiconav.geometry import ray_cast_grid
 from hiconav.mapping.frontiers import nearest_reachable_cell
 from hiconav.planning.astar import astar, smooth_path
@@ -33,17 +33,9 @@ __all__ = ["Navigator", "blocked_cells", "plan_path"]
 log = logging.getLogger(__name__)
 
 
-class _Grid(Protocol):
-    state: np.ndarray
-    inflated: np.ndarray
-    origin: np.ndarray
-    resolution: float
-
-    def world_to_cell(self, xy: np.ndarray) -> np.ndarray: ...
-    def cell_to_world(self, rc: np.ndarray) -> np.ndarray: ...
 
 
-def blocked_cells(grid: _Grid, *, through_unknown: bool = False) -> np.ndarray:
+def blocked_cells(grid: GridLike, *, through_unknown: bool = False) -> np.ndarray:
     """(H, W) bool cells the robot centre must not enter: inflated obstacles (+ unknown cells)."""
     blocked = np.array(grid.inflated, dtype=bool, copy=True)
     if not through_unknown:
@@ -132,7 +124,7 @@ class Navigator:
         self._virtual.clear()
 
     # ------------------------------------------------------------------ planning
-    def _blocked(self, grid: _Grid, start_rc: np.ndarray) -> np.ndarray:
+    def _blocked(self, grid: GridLike, start_rc: np.ndarray) -> np.ndarray:
         cfg = self.config
         blocked = blocked_cells(grid, through_unknown=cfg.plan_through_unknown)
         res = grid.resolution
@@ -153,7 +145,7 @@ class Navigator:
             sub[m & (clearance > here + 0.5) & (free > 0)] = False  # strictly away from obstacles
         return blocked
 
-    def plan(self, grid: _Grid, pose: Pose2D) -> bool:
+    def plan(self, grid: GridLike, pose: Pose2D) -> bool:
         """Plan from ``pose`` to the goal; sets ``path_xy``. False (status "no_path") if none."""
         self._ticks_since_plan = 0
         self.n_plans += 1
@@ -188,7 +180,7 @@ class Navigator:
         self.status = "following"
         return True
 
-    def _path_blocked(self, grid: _Grid, pose: Pose2D) -> bool:
+    def _path_blocked(self, grid: GridLike, pose: Pose2D) -> bool:
         """True if a remaining cell of the current path is now blocked (escape rule included)."""
         if self._dense_xy is None:
             return True
@@ -203,7 +195,7 @@ class Navigator:
         blocked = self._blocked(grid, grid.world_to_cell(pose.xy))
         return bool(blocked[rc[:, 0], rc[:, 1]].any())
 
-    def _need_replan(self, grid: _Grid, pose: Pose2D) -> bool:
+    def _need_replan(self, grid: GridLike, pose: Pose2D) -> bool:
         if self.path_xy is None or self._ticks_since_plan >= self.config.replan_every:
             return True
         if self._path_blocked(grid, pose):
@@ -224,7 +216,7 @@ class Navigator:
             )
         return False
 
-    def _open_side(self, grid: _Grid, pose: Pose2D) -> int:
+    def _open_side(self, grid: GridLike, pose: Pose2D) -> int:
         """+1 if the left (CCW) side is more open than the right, else -1 (ray casting)."""
         blocked = blocked_cells(grid, through_unknown=True)
         rc = grid.world_to_cell(pose.xy) + 0.5
@@ -240,7 +232,7 @@ class Navigator:
         self._virtual.append((pose.x + ahead * math.cos(pose.yaw), pose.y + ahead * math.sin(pose.yaw), r))
 
     # ------------------------------------------------------------------ discrete control
-    def step(self, grid: _Grid, pose: Pose2D) -> DiscreteAction:
+    def step(self, grid: GridLike, pose: Pose2D) -> DiscreteAction:
         """The next discrete action toward the goal (STOP when reached or when there is no path)."""
         cfg = self.config
         self._ticks_since_plan += 1
@@ -293,7 +285,7 @@ class Navigator:
 
     # ------------------------------------------------------------------ velocity control
     def step_velocity(
-        self, grid: _Grid, pose: Pose2D, dt: float = 0.1, stamp: float = 0.0
+        self, grid: GridLike, pose: Pose2D, dt: float = 0.1, stamp: float = 0.0
     ) -> VelocityCommand:
         """The next velocity command toward the goal (zero when reached or when there is no path)."""
         cfg = self.config
