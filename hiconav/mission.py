@@ -251,6 +251,7 @@ class MissionResult:
     report: Any = None
     pauses: list[dict[str, Any]] = field(default_factory=list)  # failsafe pauses of a live robot
     driver: str = "sim"
+    mission_feedback: str = ""  # the tree's last words, e.g. "Approach: no reachable approach cell"
 
     def summary(self) -> dict[str, Any]:
         m = self.metrics
@@ -323,7 +324,8 @@ def run_mission(house: Any, episode: Any, *, seed: int = 0, overrides: dict[str,
     result = MissionResult(metrics, _termination(report, parts), mission_status, failure, clock, report.clock_s,
                            report.wall_s, parts.detector_name, parts.reasoner_name, parts.fallbacks,
                            {k: v for k, v in report.stats.items()}, parts.driver.path, parts.mission.history,
-                           parts.reasoning.events, report)
+                           parts.reasoning.events, report,
+                           mission_feedback=parts.mission.finished.feedback if parts.mission.finished else "")
     if robot is not None:
         result.pauses = list(getattr(parts.driver, "pauses", []))
         result.driver = str(getattr(robot, "name", "robot"))
@@ -410,6 +412,7 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
         detector=result.detector, reasoner=result.reasoner, error=result.failure,
         error_kind="runtime" if result.failure else None,
         extra={"mission": result.mission_status, "fallbacks": result.fallbacks,
+               "feedback": result.mission_feedback,
                "dropped": {k: dict(v.dropped) for k, v in result.stats.items() if v.dropped}})
 
 

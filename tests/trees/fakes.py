@@ -46,6 +46,7 @@ def obj(oid: int, label: str, x: float, y: float, n_obs: int = 1, conf: float = 
 class FakeMemory:
     objects: tuple = ()
     anchors: tuple = ()
+    version: int = 0  # frames integrated
 
     def anchor(self, anchor_id: int):
         for a in self.anchors:
@@ -54,8 +55,9 @@ class FakeMemory:
         raise KeyError(anchor_id)
 
 
-def world(pose: Pose2D, objects=(), seq: int = 0, grid: FakeGrid | None = None) -> WorldSnapshot:
-    return WorldSnapshot(seq, 0.0, pose, grid if grid is not None else open_grid(), FakeMemory(tuple(objects)))
+def world(pose: Pose2D, objects=(), seq: int = 0, grid: FakeGrid | None = None, version: int = 0) -> WorldSnapshot:
+    return WorldSnapshot(seq, 0.0, pose, grid if grid is not None else open_grid(),
+                         FakeMemory(tuple(objects), version=version))
 
 
 @dataclass(frozen=True)

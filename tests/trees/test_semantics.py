@@ -154,14 +154,43 @@ root:
 def test_verify_confirms_with_fresh_views_when_close(tmp_path):
     clock = Clock()
     ctx = _ctx(clock)
-    ctx.world = world(Pose2D(4.0, 4.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=4)])
+    ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=4)], version=1)
     tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
                                         "      - VerifyTarget: {min_fresh_views: 2}\n"), ctx)
     assert tree.tick() == S.RUNNING
-    ctx.world = world(Pose2D(4.0, 4.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=5)])
+    ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=5)], version=2)
     assert tree.tick() == S.RUNNING
-    ctx.world = world(Pose2D(4.0, 4.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=6)])
+    ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=6)], version=3)
     assert tree.tick() == S.SUCCESS
+
+
+def test_verify_rejects_a_candidate_rarely_detected_while_in_view(tmp_path):
+    """A spurious box that fell on a place once is outvoted by the frames that show nothing there."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=1)], version=1)
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - VerifyTarget: {min_fresh_views: 2, max_view_frames: 10}\n"), ctx)
+    n_obs = 1
+    for version in range(2, 12):
+        n_obs += version in (4, 9)  # two fresh views in ten frames: below the 50% detection rate
+        ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=n_obs)], version=version)
+        status = tree.tick()
+    assert status == S.FAILURE
+    assert ctx.rejections and ctx.rejections[-1][0] == 3 and "2 of 10 frames" in ctx.rejections[-1][1]
+    assert 3 in ctx.rejected
+
+
+def test_verify_counts_only_frames_with_the_candidate_in_view(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    away = Pose2D(4.0, 4.0, math.pi)  # the bed is behind the robot
+    ctx.world = world(away, [obj(3, "bed", 5.0, 5.0, n_obs=1)], version=1)
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - VerifyTarget: {min_fresh_views: 2, max_view_frames: 5}\n"), ctx)
+    for version in range(2, 20):
+        ctx.world = world(away, [obj(3, "bed", 5.0, 5.0, n_obs=1)], version=version)
+        assert tree.tick() == S.RUNNING  # not in view: neither confirmed nor rejected
 
 
 def test_approach_sends_a_free_cell_within_distance_facing_the_target(tmp_path):

@@ -19,21 +19,26 @@ from hiconav.trees.behaviours.base import MissionBehaviour, Status
 from hiconav.trees.context import Candidate
 from hiconav.trees.registry import Param, register_behaviour
 
+from hiconav.mapping.occupancy import lethal_mask
 from hiconav.types import Goal, wrap_angle
 
 
 def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy: np.ndarray,
-                  max_distance: float, exclude: list[np.ndarray] | None = None) -> np.ndarray | None:
+                  max_distance: float, exclude: list[np.ndarray] | None = None,
+                  tight: bool = False) -> np.ndarray | None:
     """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint.
 
     grid: snapshot with ``state`` (H, W) int8 (0 free), ``inflated`` (H, W) bool, ``origin`` (2,),
     ``resolution``; box_min / box_max: (3,) world metres (only x, y used); robot_xy: (2,) world.
+    ``tight``: the robot may reach the cell through passages only the robot radius clears (see
+    ``OccupancyGrid.lethal``), and such cells count when no cell keeps the inflation margin.
     Returns the (2,) world xy of the chosen cell centre (nearest to the robot), or None.
     """
     from scipy import ndimage
 
     state = np.asarray(grid.state)
-    free = (state == 0) & ~np.asarray(grid.inflated, dtype=bool)
+    roomy = (state == 0) & ~np.asarray(grid.inflated, dtype=bool)
+    free = (state == 0) & ~lethal_mask(grid) if tight else roomy
     res = float(grid.resolution)
     ox, oy = float(grid.origin[0]), float(grid.origin[1])
     h, w = free.shape
@@ -62,6 +67,8 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
         ok &= np.hypot(x - ex[0], y - ex[1]) > 0.3
     if not np.any(ok):
         return None
+    if tight and np.any(ok & roomy[r0:r1, c0:c1]):
+        ok &= roomy[r0:r1, c0:c1]
     cost = np.hypot(x - robot_xy[0], y - robot_xy[1])
     cost = np.where(ok, cost, np.inf)
     i = int(np.argmin(cost))
@@ -209,6 +216,8 @@ class _GoToObject(MissionBehaviour):
             return False
         robot = np.array([pose.x, pose.y])
         cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded)
+        if cell is None:  # furniture around it: a cell only the robot radius clears will do
+            cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, tight=True)
         if cell is None:
             return False
         self._cell = cell
@@ -225,17 +234,33 @@ class _GoToObject(MissionBehaviour):
 @register_behaviour()
 class VerifyTarget(_GoToObject):
     """Go within ``verify_distance`` of the candidate, facing it, and confirm it with fresh views:
-    the target-labelled object nodes at the candidate's place gain ``min_fresh_views`` new
-    observations while the robot is close. A candidate that vanishes from memory or changes label
-    is rejected for good (a false positive); one that cannot be reached or re-observed in time is
-    deferred for ``defer_s`` (rejected for good after ``max_deferrals``), so exploration resumes."""
+    while the robot is close and the candidate's centre is inside the camera's field of view, the
+    target-labelled object nodes at the candidate's place must gain ``min_fresh_views`` new
+    observations and be detected in at least ``min_detection_rate`` of those frames (the frames
+    the memory integrated, counted by its version). A real object is detected in most frames that show it; a
+    spurious box lands at a random place in a random frame, so one that happened to fall on the
+    candidate's place is outvoted by the frames that show nothing there. A candidate seen in too
+    few of ``max_view_frames`` frames, or that vanishes from memory or changes label, is rejected
+    for good (a false positive); one that cannot be reached or re-observed in time is deferred
+    for ``defer_s`` (rejected for good after ``max_deferrals``), so exploration resumes.
+
+    Fresh views count only target-labelled nodes whose box overlaps the candidate's (grown by
+    ``support_margin``): counting every same-label node within a radius let spurious boxes cast
+    while the robot stares at a false candidate confirm it.
+    """
 
     PARAMS = {
         "verify_distance": Param(float, 1.5, minimum=0.3, maximum=10.0),
         "min_fresh_views": Param(int, 2, minimum=0, maximum=100),
+        "min_detection_rate": Param(float, 0.5, minimum=0.0, maximum=1.0,
+                                    doc="fresh views per frame with the candidate in view"),
+        "max_view_frames": Param(int, 30, minimum=1, maximum=10000,
+                                 doc="frames in view after which a rarely detected candidate is rejected"),
+        "hfov_deg": Param(float, 79.0, minimum=1.0, maximum=360.0, doc="the camera's horizontal field of view"),
         "min_confidence": Param(float, 0.3, minimum=0.0, maximum=1.0),
         "timeout_s": Param(float, 60.0, minimum=0.1, maximum=3600.0),
-        "support_radius": Param(float, 1.0, minimum=0.0, maximum=5.0, doc="same-label nodes this close count"),
+        "support_margin": Param(float, 0.15, minimum=0.0, maximum=2.0,
+                                doc="same-label nodes whose box overlaps the candidate's grown by this count"),
         "defer_s": Param(float, 30.0, minimum=0.0, maximum=3600.0),
         "max_deferrals": Param(int, 2, minimum=1, maximum=100),
     }
@@ -249,6 +274,10 @@ class VerifyTarget(_GoToObject):
         self._excluded: list[np.ndarray] = []
         self._cand: Candidate | None = self.read("target")
         self._support_close: int | None = None
+        self._support_prev = 0
+        self._fresh = 0
+        self._in_view = 0  # integrated frames (memory versions) with the candidate in the field of view
+        self._frame: int | None = None
         self._glance = 0
         if self._cand is not None and self.context.verify:
             self._send(self._cand, self._goal_distance())
@@ -262,12 +291,33 @@ class VerifyTarget(_GoToObject):
         labels = set(self.context.task.targets) if self.context.task is not None else {cand.label}
         labels.add(cand.label)
         n, conf = 0, 0.0
+        margin = self.param("support_margin")
+        lo, hi = np.asarray(cand.box_min)[:2] - margin, np.asarray(cand.box_max)[:2] + margin
         for o in memory.objects:
-            if o.label in labels and float(np.hypot(*(np.asarray(o.center)[:2] - cand.center[:2]))) <= \
-                    self.param("support_radius") + 1e-9:
+            if o.label not in labels:
+                continue
+            o_lo, o_hi = np.asarray(o.box_min)[:2], np.asarray(o.box_max)[:2]
+            if np.all(o_lo <= hi) and np.all(o_hi >= lo):
                 n += int(o.n_obs)
                 conf = max(conf, float(o.confidence))
         return n, conf
+
+    def _count_frames(self, cand: Candidate, support: int) -> None:
+        """Add the frames since the last tick to ``_in_view`` when the candidate is in view, and
+        the support gained to ``_fresh``."""
+        ctx = self.context
+        memory = ctx.memory
+        frame = getattr(memory, "version", None)  # counts the frames the memory integrated
+        pose = ctx.pose
+        if frame is None or pose is None or frame == self._frame:
+            return
+        new = 1 if self._frame is None else max(int(frame) - int(self._frame), 1)
+        self._frame = int(frame)
+        bearing = abs(wrap_angle(_facing(np.array([pose.x, pose.y]), cand.center) - pose.yaw))
+        if math.degrees(bearing) <= 0.5 * self.param("hfov_deg"):
+            self._in_view += new
+            self._fresh += max(support - self._support_prev, 0)
+        self._support_prev = support
 
     def _reject(self, why: str, permanent: bool) -> Status:
         cand = self._cand
@@ -299,14 +349,17 @@ class VerifyTarget(_GoToObject):
         if ctx.distance_to_box(box_min, box_max) <= self.param("verify_distance") + 0.25:
             support, conf = self._support(current)
             if self._support_close is None:
-                self._support_close = support
-            fresh = support - self._support_close
-            if fresh >= self.param("min_fresh_views"):
+                self._support_close = self._support_prev = support
+            self._count_frames(current, support)
+            fresh, frames = self._fresh, self._in_view
+            if fresh >= self.param("min_fresh_views") and fresh >= self.param("min_detection_rate") * frames:
                 if conf >= self.param("min_confidence"):
                     self.write("target", current)
-                    self.feedback_message = f"confirmed {obj.label} #{obj.id} with {fresh} fresh views"
+                    self.feedback_message = f"confirmed {obj.label} #{obj.id}: {fresh} fresh views in {frames} frames"
                     return Status.SUCCESS
                 return self._reject(f"confidence {conf:.2f} below {self.param('min_confidence')}", True)
+            if frames >= self.param("max_view_frames"):
+                return self._reject(f"detected in {fresh} of {frames} frames in view", True)
         if ctx.now() - self._start > self.param("timeout_s"):
             return self._reject("no fresh views before the timeout", False)
         state = "pending" if self._seq is None else ctx.nav_state(self._seq)
@@ -329,7 +382,12 @@ class VerifyTarget(_GoToObject):
 
 @register_behaviour()
 class Approach(_GoToObject):
-    """Reach a free cell within ``distance`` of the target's footprint, facing it."""
+    """Reach a free cell within ``distance`` of the target's footprint, facing it.
+
+    When no approach cell is reachable or time runs out, the candidate is deferred for
+    ``defer_s`` before FAILURE, so that a Retry above explores on (the map may yet open a way to
+    it, or show a better candidate) instead of picking the same unreachable object again.
+    """
 
     PARAMS = {
         "distance": Param(float, 0.8, minimum=0.1, maximum=5.0, doc="stay below the success distance"),
@@ -338,6 +396,7 @@ class Approach(_GoToObject):
         "timeout_s": Param(float, 120.0, minimum=0.1, maximum=3600.0),
         "max_distance": Param(float, 1.5, minimum=0.1, maximum=5.0,
                               doc="settle this far at most when nothing closer is reachable"),
+        "defer_s": Param(float, 30.0, minimum=0.0, maximum=3600.0, doc="an unreachable candidate waits this long"),
     }
 
     def initialise(self) -> None:
@@ -366,8 +425,7 @@ class Approach(_GoToObject):
             self.feedback_message = f"at {cand.label} #{cand.object_id}"
             return Status.SUCCESS
         if ctx.now() - self._start > self.param("timeout_s"):
-            self.feedback_message = "timed out"
-            return Status.FAILURE
+            return self._give_up(cand, "timed out")
         state = "pending" if self._seq is None else ctx.nav_state(self._seq)
         if self._seq is None or state in ("failed", "reached"):
             if self._seq is not None and getattr(self, "_cell", None) is not None:
@@ -397,10 +455,14 @@ class Approach(_GoToObject):
                                                0.5, "look", cand.object_id))
                 sent = True
             if not sent and ctx.grid is not None and ctx.pose is not None:
-                self.feedback_message = "no reachable approach cell"
-                return Status.FAILURE
+                return self._give_up(cand, "no reachable approach cell")
         self.feedback_message = f"approaching {cand.label} #{cand.object_id}"
         return Status.RUNNING
+
+    def _give_up(self, cand: Candidate, why: str) -> Status:
+        self.context.reject(cand.object_id, f"approach: {why}", permanent=False, defer_s=self.param("defer_s"))
+        self.feedback_message = why
+        return Status.FAILURE
 
 
 @register_behaviour()
