@@ -49,8 +49,8 @@ class CostConfig(BaseModel):
     w_f: float = Field(1.0, ge=0.0, description="weight of the openness term c_s (s), eq. 19, 20")
     h_max: float = Field(3.0, gt=0.0, description="truncation of the ray-cast openness h_k (m), eq. 19")
     min_speed: float = Field(0.05, ge=0.0, description="below this |v_0| (m/s) c_c is 0 (no heading)")
-    stride: int = Field(2, ge=1, description="the geodesic Dijkstra runs on the inflated grid coarsened "
-                        "by this factor (a coarse cell is traversable if all its fine cells are)")
+    stride: int = Field(2, ge=1, description="the geodesic Dijkstra runs on the grid coarsened "
+                        "by this factor (a coarse cell is traversable if any fine cell is and none is an obstacle)")
     snap_radius_m: float = Field(0.5, ge=0.0, description="a robot/viewpoint cell that is blocked snaps to "
                                  "the nearest traversable cell within this radius (m)")
     unknown_traversable: bool = Field(False, description="treat unknown cells as traversable (optimistic)")

@@ -5,12 +5,11 @@ c_c(k) = arccos((p_k - p_0) . v_0 / (|p_k - p_0| |v_0|)), 0 when |v_0| < min_spe
 c_s(k) = h_k / h_max                                                            (eq. 19)
 M_0k = t(0, k) + w_c c_c(k) + w_f c_s(k);  M_krks = t(kr, ks);  M_k0 = 0         (eq. 20, 21)
 
-- d is the geodesic distance on the current inflated grid: traversable = known free and not
-  inflated (unknown cells too if ``unknown_traversable``). One multi-source Dijkstra
+- d is the geodesic distance on the current grid: traversable = known free and clear of the
+  robot radius (unknown cells too if ``unknown_traversable``). One multi-source Dijkstra
   (scipy.sparse.csgraph.dijkstra with ``indices=`` all n+1 sources) on an 8-connected graph of
-  the grid coarsened by ``stride`` (a coarse cell is traversable only if all its fine cells are:
-  walls never leak; passages narrower than 2 * stride - 1 fine cells close, which the robot
-  radius inflation makes rare at stride 2 and 5 cm cells), never n^2 A* runs. A robot or viewpoint cell that is blocked snaps to the nearest traversable cell within
+  the grid coarsened by ``stride`` (``coarse_traversable``: tight passages stay open, walls do
+  not leak), never n^2 A* runs. A robot or viewpoint cell that is blocked snaps to the nearest traversable cell within
   ``snap_radius_m``. Frontiers unreachable from the robot are dropped.
 - p_k is the frontier's viewpoint; its heading xi_k is the direction from the viewpoint to the
   frontier centroid (from the robot to the centroid when they coincide); the robot's heading
@@ -35,7 +34,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from hiconav.exploration.config import CostConfig
 from hiconav.mapping.frontiers import nearest_reachable_cell
-from hiconav.mapping.occupancy import GridLike
+from hiconav.mapping.occupancy import GridLike, lethal_mask
 from hiconav.types import Frontier, wrap_angle
 
 UNKNOWN = -1
@@ -62,30 +61,43 @@ class CostMatrix:
 
 
 def traversable_mask(grid: GridLike, config: CostConfig | None = None) -> np.ndarray:
-    """(H, W) bool cells the robot may cross: free (or unknown if configured) and not inflated."""
+    """(H, W) bool cells the robot may cross: free (or unknown if configured) and clear of the robot
+    radius (``lethal_mask``: tight passages count, as the navigator may plan through them)."""
     cfg = config or CostConfig()
     state = np.asarray(grid.state)
     ok = (state == 0) | (cfg.unknown_traversable & (state == UNKNOWN))
-    return ok & ~np.asarray(grid.inflated, dtype=bool)
+    return ok & ~lethal_mask(grid)
 
 
 def _coarsen(mask: np.ndarray, stride: int) -> np.ndarray:
-    """(H, W) bool -> (ceil(H/s), ceil(W/s)) bool, True where every fine cell is True
-    (conservative: a thin wall can never leak; passages narrower than 2s-1 cells close)."""
+    """(H, W) bool -> (ceil(H/s), ceil(W/s)) bool, True where any fine cell is True."""
     if stride == 1:
         return mask.copy()
     H, W = mask.shape
     Hc, Wc = -(-H // stride), -(-W // stride)
     pad = np.zeros((Hc * stride, Wc * stride), dtype=bool)
     pad[:H, :W] = mask
-    # AND of the stride x stride strided views: the same result as
-    # pad.reshape(Hc, s, Wc, s).all(axis=(1, 3)), ~20x faster (numpy's multi-axis bool reduction is slow)
+    # OR of the stride x stride strided views: the same result as
+    # pad.reshape(Hc, s, Wc, s).any(axis=(1, 3)), ~20x faster (numpy's multi-axis bool reduction is slow)
     out = pad[0::stride, 0::stride].copy()
     for i in range(stride):
         for j in range(stride):
             if i or j:
-                out &= pad[i::stride, j::stride]
+                out |= pad[i::stride, j::stride]
     return out
+
+
+def coarse_traversable(grid: GridLike, config: CostConfig) -> np.ndarray:
+    """The traversable mask coarsened by ``config.stride``: a coarse cell is traversable when any
+    of its fine cells is and none is an obstacle. Passages one fine cell wide stay open (tight
+    doorways, where only the robot radius is clear, look like that; an all-cells rule closed them
+    and dropped every frontier behind them), and walls cannot leak: a coarse cell on a wall is
+    blocked, and diagonal steps may not cut between two blocked coarse cells."""
+    trav = traversable_mask(grid, config)
+    s = config.stride
+    if s == 1:
+        return trav
+    return _coarsen(trav, s) & ~_coarsen(np.asarray(grid.state) == 1, s)
 
 
 def _grid_graph(mask: np.ndarray, step: float) -> tuple[sp.csr_matrix, np.ndarray]:
@@ -100,6 +112,8 @@ def _grid_graph(mask: np.ndarray, step: float) -> tuple[sp.csr_matrix, np.ndarra
         r2, c2 = rr + dr, cc + dc
         ok = (r2 < H) & (c2 >= 0) & (c2 < W)
         ok[ok] = mask[r2[ok], c2[ok]]
+        if dr and dc:  # no corner cutting: both straight neighbours must be traversable too
+            ok[ok] = mask[rr[ok], c2[ok]] & mask[r2[ok], cc[ok]]
         rows.append(node[rr[ok], cc[ok]])
         cols.append(node[r2[ok], c2[ok]])
         vals.append(np.full(int(ok.sum()), step * (math.sqrt(2.0) if dr and dc else 1.0)))
@@ -118,7 +132,7 @@ def geodesic_distances(grid: GridLike, points_xy: np.ndarray, config: CostConfig
     if k == 0:
         return out
     s = cfg.stride
-    coarse = _coarsen(traversable_mask(grid, cfg), s)
+    coarse = coarse_traversable(grid, cfg)
     graph, node = _grid_graph(coarse, s * grid.resolution)
     rc = np.asarray(grid.world_to_cell(pts)) // s
     radius = math.ceil(cfg.snap_radius_m / (s * grid.resolution))

@@ -3,8 +3,9 @@
 A frontier cell is a free cell 4-adjacent to an unknown cell. Frontier cells are clustered
 (8-connected components, cv2.connectedComponentsWithStats), small clusters are dropped, long
 ones split along their principal axis, and each cluster gets a centroid and a viewpoint: the
-nearest free, non-inflated cell to the centroid that is connected to the robot through such
-cells. Ids stay stable across updates (and across grid growth) by matching clusters to the
+nearest free, non-inflated cell to the centroid that is connected to the robot through cells
+clear of the robot radius (tight passages count; see ``OccupancyGrid.lethal``), or the nearest
+such connected cell when none keeps the inflation margin. Ids stay stable across updates (and across grid growth) by matching clusters to the
 previous ones on shared global cells, then on centroid distance.
 
 It must not score or order frontiers (that is exploration's job) and must not modify the grid.
@@ -17,7 +18,7 @@ import math
 import cv2
 import numpy as np
 
-from hiconav.mapping.occupancy import GridLike
+from hiconav.mapping.occupancy import GridLike, lethal_mask
 from hiconav.mapping.config import FrontierConfig
 from hiconav.types import Frontier
 
@@ -123,7 +124,10 @@ class FrontierTracker:
         state = full_state[r0:r1, c0:c1]
         # frontier cells; the grid's own edge counts as unknown, the crop's edge is unknown anyway
         fmask = frontier_mask(state)
-        traversable = (state == 0) & ~np.asarray(grid.inflated[r0:r1, c0:c1], dtype=bool)
+        # reachability through tight passages too (robot radius clear, no margin: the navigator
+        # plans through them when nothing wider connects); viewpoints prefer cells with the margin
+        traversable = (state == 0) & ~lethal_mask(grid)[r0:r1, c0:c1]
+        roomy = traversable & ~np.asarray(grid.inflated[r0:r1, c0:c1], dtype=bool)
         rrc = grid.world_to_cell(np.asarray(robot_xy, dtype=np.float64)[:2]) - off
         start = nearest_reachable_cell(
             traversable, (int(rrc[0]), int(rrc[1])), int(math.ceil(cfg.robot_search_m / res))
@@ -150,7 +154,9 @@ class FrontierTracker:
                 if cells.shape[0] < cfg.min_size_cells:
                     continue
                 cen_rc = cells.mean(axis=0)
-                vp = self._viewpoint(reach, free_labels, cells, cen_rc, search)
+                vp = self._viewpoint(reach & roomy, free_labels, cells, cen_rc, search)
+                if vp is None:
+                    vp = self._viewpoint(reach, free_labels, cells, cen_rc, search)
                 if vp is None and cfg.drop_unreachable:
                     continue
                 cells_full = (cells + off).astype(np.int32)

@@ -35,7 +35,8 @@ from hiconav.geometry import GridFrame, pixel_rays, validate_depth
 from hiconav.mapping.config import OccupancyConfig
 from hiconav.types import Frame, freeze
 
-__all__ = ["FREE", "OCCUPIED", "UNKNOWN", "GridSnapshot", "IntegrationStats", "OccupancyGrid", "disk_kernel"]
+__all__ = ["FREE", "OCCUPIED", "UNKNOWN", "GridSnapshot", "IntegrationStats", "OccupancyGrid", "disk_kernel",
+           "lethal_mask"]
 
 UNKNOWN, FREE, OCCUPIED = -1, 0, 1
 
@@ -70,12 +71,20 @@ class GridLike(Protocol):
     """What consumers (frontiers, planning, exploration costs) need of an OccupancyGrid / GridSnapshot."""
 
     state: np.ndarray  # (H, W) int8: -1 unknown, 0 free, 1 occupied
-    inflated: np.ndarray  # (H, W) bool: occupied dilated by the robot radius
+    inflated: np.ndarray  # (H, W) bool: occupied dilated by the robot radius + inflation margin
+    lethal: np.ndarray  # (H, W) bool: occupied dilated by the robot radius alone (no margin)
     origin: np.ndarray  # (2,) world xy of the corner of cell (0, 0)
     resolution: float  # m per cell
 
     def world_to_cell(self, xy: np.ndarray) -> np.ndarray: ...
     def cell_to_world(self, rc: np.ndarray) -> np.ndarray: ...
+
+
+def lethal_mask(grid: GridLike) -> np.ndarray:
+    """(H, W) bool cells the robot centre cannot occupy at all (``grid.inflated`` for grid-likes
+    without a ``lethal`` layer, e.g. hand-made test grids: then there are no tight passages)."""
+    lethal = getattr(grid, "lethal", None)
+    return np.asarray(grid.inflated if lethal is None else lethal, dtype=bool)
 
 
 class _OccupancyFields(GridFrame):
@@ -105,7 +114,9 @@ class GridSnapshot(_OccupancyFields):
     """Read-only copy of the grid for other actors.
 
     state: (H, W) int8 (-1 unknown, 0 free, 1 occupied); inflated: (H, W) bool (occupied
-    dilated by the robot radius); explored: (H, W) bool (ever observed); origin: (2,) world xy
+    dilated by the robot radius + inflation margin); lethal: (H, W) bool (dilated by the robot
+    radius alone: the tight passages only a fallback plan may use; ``inflated`` when not given,
+    i.e. no tight passages); explored: (H, W) bool (ever observed); origin: (2,) world xy
     of the corner of cell (0, 0); resolution: m per cell; version: number of integrated frames.
     """
 
@@ -116,9 +127,12 @@ class GridSnapshot(_OccupancyFields):
     resolution: float
     version: int
     stamp: float
+    lethal: np.ndarray | None = None  # type: ignore[assignment]  # filled in __post_init__
 
     def __post_init__(self) -> None:
-        for name in ("state", "inflated", "explored", "origin"):
+        if self.lethal is None:
+            object.__setattr__(self, "lethal", self.inflated)
+        for name in ("state", "inflated", "lethal", "explored", "origin"):
             freeze(getattr(self, name))
 
 
@@ -139,7 +153,8 @@ class OccupancyGrid(_OccupancyFields):
     """Growing log-odds occupancy grid at ``config.resolution`` m per cell.
 
     Public attributes (read them, do not write them): state (H, W) int8 (-1 unknown, 0 free,
-    1 occupied), inflated (H, W) bool, explored (H, W) bool, origin (2,) world xy of the corner of
+    1 occupied), inflated (H, W) bool (robot radius + margin), lethal (H, W) bool (robot radius
+    only: the robot centre cannot be there at all), explored (H, W) bool, origin (2,) world xy of the corner of
     cell (0, 0), resolution (m). Cell (i, j) has its centre at x = ox + (j + 0.5) * res,
     y = oy + (i + 0.5) * res.
     """
@@ -151,6 +166,7 @@ class OccupancyGrid(_OccupancyFields):
         self.logodds = np.zeros((0, 0), dtype=np.int8)
         self.state = np.zeros((0, 0), dtype=np.int8)
         self.inflated = np.zeros((0, 0), dtype=bool)
+        self.lethal = np.zeros((0, 0), dtype=bool)
         self.explored = np.zeros((0, 0), dtype=bool)
         self.version = 0
         self.stamp = 0.0
@@ -158,6 +174,7 @@ class OccupancyGrid(_OccupancyFields):
         c = self.config
         self._inflate_cells = (c.robot_radius + c.inflation_margin) / self.resolution
         self._kernel = disk_kernel(self._inflate_cells)
+        self._lethal_kernel = disk_kernel(c.robot_radius / self.resolution)
         self._footprint = disk_kernel(0.8 * c.robot_radius / self.resolution).astype(bool)
 
     # ------------------------------------------------------------------ grid geometry
@@ -198,6 +215,7 @@ class OccupancyGrid(_OccupancyFields):
         self.state = np.where(explored, (logodds > 0).astype(np.int8), np.int8(UNKNOWN)).astype(np.int8)
         occ = (self.state == OCCUPIED).astype(np.uint8)
         self.inflated = cv2.dilate(occ, self._kernel).astype(bool)
+        self.lethal = cv2.dilate(occ, self._lethal_kernel).astype(bool)
         return True
 
     # ------------------------------------------------------------------ integration
@@ -383,6 +401,8 @@ class OccupancyGrid(_OccupancyFields):
         occ = (self.state[dr0:dr1, dc0:dc1] == OCCUPIED).astype(np.uint8)
         dil = cv2.dilate(occ, self._kernel, borderType=cv2.BORDER_CONSTANT, borderValue=0)
         self.inflated[er0:er1, ec0:ec1] = dil[er0 - dr0 : er1 - dr0, ec0 - dc0 : ec1 - dc0].astype(bool)
+        dil = cv2.dilate(occ, self._lethal_kernel, borderType=cv2.BORDER_CONSTANT, borderValue=0)
+        self.lethal[er0:er1, ec0:ec1] = dil[er0 - dr0 : er1 - dr0, ec0 - dc0 : ec1 - dc0].astype(bool)
 
         self.version += 1
         self.stamp = float(frame.stamp)
@@ -401,6 +421,7 @@ class OccupancyGrid(_OccupancyFields):
         return GridSnapshot(
             state=self.state.copy(),
             inflated=self.inflated.copy(),
+            lethal=self.lethal.copy(),
             explored=self.explored.copy(),
             origin=self.origin.copy(),
             resolution=self.resolution,

@@ -44,6 +44,9 @@ class NavigatorConfig(BaseModel):
     goal_snap_m: float = Field(
         1.0, ge=0.0, description="a blocked goal moves to the nearest free cell within this"
     )
+    tight_fallback: bool = Field(
+        True, description="when no path keeps the inflation margin, plan through passages only the robot radius clears"
+    )
     replan_every: int = Field(10, ge=1, description="re-plan at least every n steps")
     deviation_m: float = Field(0.5, gt=0.0, description="re-plan when this far from the path")
     stuck_progress_m: float = Field(0.05, ge=0.0, description="a forward step moving less than this is stuck")

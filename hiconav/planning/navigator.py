@@ -19,7 +19,7 @@ import math
 import cv2
 import numpy as np
 
-from hiconav.mapping.occupancy import GridLike
+from hiconav.mapping.occupancy import GridLike, lethal_mask
 from hiconav.geometry import ray_cast_grid
 from hiconav.mapping.frontiers import nearest_reachable_cell
 from hiconav.planning.astar import astar, smooth_path
@@ -35,9 +35,11 @@ log = logging.getLogger(__name__)
 
 
 
-def blocked_cells(grid: GridLike, *, through_unknown: bool = False) -> np.ndarray:
-    """(H, W) bool cells the robot centre must not enter: inflated obstacles (+ unknown cells)."""
-    blocked = np.array(grid.inflated, dtype=bool, copy=True)
+def blocked_cells(grid: GridLike, *, through_unknown: bool = False, tight: bool = False) -> np.ndarray:
+    """(H, W) bool cells the robot centre must not enter: inflated obstacles (+ unknown cells);
+    ``tight``: obstacles grown by the robot radius alone (``lethal_mask``), for passages the
+    inflation margin closes."""
+    blocked = np.array(lethal_mask(grid) if tight else grid.inflated, dtype=bool, copy=True)
     if not through_unknown:
         blocked |= grid.state == -1
     return blocked
@@ -99,6 +101,7 @@ class Navigator:
         self._elapsed = 0.0
         self.n_plans = 0
         self.n_recoveries = 0
+        self.tight = False  # the current path uses a tight passage (robot radius clear, no margin)
 
     # ------------------------------------------------------------------ goal
     def set_goal(self, goal: Goal | None) -> None:
@@ -124,9 +127,9 @@ class Navigator:
         self._virtual.clear()
 
     # ------------------------------------------------------------------ planning
-    def _blocked(self, grid: GridLike, start_rc: np.ndarray) -> np.ndarray:
+    def _blocked(self, grid: GridLike, start_rc: np.ndarray, tight: bool = False) -> np.ndarray:
         cfg = self.config
-        blocked = blocked_cells(grid, through_unknown=cfg.plan_through_unknown)
+        blocked = blocked_cells(grid, through_unknown=cfg.plan_through_unknown, tight=tight)
         res = grid.resolution
         for x, y, r in self._virtual:
             rc = grid.world_to_cell(np.array([x, y]))
@@ -146,30 +149,28 @@ class Navigator:
         return blocked
 
     def plan(self, grid: GridLike, pose: Pose2D) -> bool:
-        """Plan from ``pose`` to the goal; sets ``path_xy``. False (status "no_path") if none."""
+        """Plan from ``pose`` to the goal; sets ``path_xy``. False (status "no_path") if none.
+
+        The path keeps the inflation margin from obstacles when it can; when no such path exists
+        (a doorway or a gap between furniture narrower than the robot plus twice the margin) and
+        ``tight_fallback`` is on, it plans again with the robot radius alone (``tight``)."""
         self._ticks_since_plan = 0
         self.n_plans += 1
         if self.goal is None:
             return False
-        res = grid.resolution
         h, w = grid.state.shape
         start = grid.world_to_cell(pose.xy)
         goal = grid.world_to_cell(self.goal.xy)
         if not (0 <= start[0] < h and 0 <= start[1] < w) or not (0 <= goal[0] < h and 0 <= goal[1] < w):
             self.path_xy, self._dense_xy, self.status = None, None, "no_path"
             return False
-        blocked = self._blocked(grid, start)
-        g = (int(goal[0]), int(goal[1]))
-        if blocked[g]:
-            snapped = nearest_reachable_cell(~blocked, g, int(math.ceil(self.config.goal_snap_m / res)))
-            if snapped is None:
-                self.path_xy, self._dense_xy, self.status = None, None, "no_path"
-                return False
-            g = snapped
-        cells = plan_path(
-            blocked, (int(start[0]), int(start[1])), g, int(math.ceil(self.config.window_margin_m / res))
-        )
-        if cells is None:
+        for tight in (False, True) if self.config.tight_fallback else (False,):
+            found = self._plan_on(grid, pose, start, goal, tight)
+            if found is not None:
+                blocked, cells = found
+                self.tight = tight
+                break
+        else:
             self.path_xy, self._dense_xy, self.status = None, None, "no_path"
             return False
         way = smooth_path(blocked, cells)
@@ -179,6 +180,22 @@ class Navigator:
         self._dense_xy = grid.cell_to_world(cells[1:]) if len(cells) > 1 else grid.cell_to_world(cells)
         self.status = "following"
         return True
+
+    def _plan_on(self, grid: GridLike, pose: Pose2D, start: np.ndarray, goal: np.ndarray,
+                 tight: bool) -> tuple[np.ndarray, np.ndarray] | None:
+        """(blocked mask, A* cells) of a path on the normal or the ``tight`` mask, or None."""
+        res = grid.resolution
+        blocked = self._blocked(grid, start, tight)
+        g = (int(goal[0]), int(goal[1]))
+        if blocked[g]:
+            snapped = nearest_reachable_cell(~blocked, g, int(math.ceil(self.config.goal_snap_m / res)))
+            if snapped is None:
+                return None
+            g = snapped
+        cells = plan_path(
+            blocked, (int(start[0]), int(start[1])), g, int(math.ceil(self.config.window_margin_m / res))
+        )
+        return None if cells is None else (blocked, cells)
 
     def _path_blocked(self, grid: GridLike, pose: Pose2D) -> bool:
         """True if a remaining cell of the current path is now blocked (escape rule included)."""
@@ -192,7 +209,7 @@ class Navigator:
         # only the part of the path still ahead of the robot
         k = int(np.argmin(np.hypot(*(self._dense_xy - pose.xy).T)))
         rc = rc[k:]
-        blocked = self._blocked(grid, grid.world_to_cell(pose.xy))
+        blocked = self._blocked(grid, grid.world_to_cell(pose.xy), self.tight)
         return bool(blocked[rc[:, 0], rc[:, 1]].any())
 
     def _need_replan(self, grid: GridLike, pose: Pose2D) -> bool:

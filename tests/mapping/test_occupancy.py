@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
 from hiconav.errors import FrameError
 from hiconav.geometry import pixel_rays
 from hiconav.mapping import FREE, OCCUPIED, UNKNOWN, OccupancyConfig, OccupancyGrid
+from hiconav.mapping.occupancy import disk_kernel
 from hiconav.types import CameraIntrinsics, Frame, Pose2D, camera_pose_from_base
 
 K = CameraIntrinsics.from_hfov(160, 120, 79.0)
@@ -216,3 +218,21 @@ def test_obstacle_closer_than_min_depth_stops_clearing():
     )
     for x in (0.35, 0.45, 0.55, 1.0):
         assert cell_state(grid, x, 0.0) != FREE, x
+
+
+def test_lethal_layer_is_the_robot_radius_alone_and_travels_with_snapshots():
+    """``lethal`` (robot radius) lies inside ``inflated`` (radius + margin) and equals the full-grid
+    dilation whatever the order of frames and growth; snapshots carry it read-only."""
+    grid = OccupancyGrid(OccupancyConfig(initial_size_m=4.0, grow_padding_m=1.0))
+    grid.integrate(render_boxes(Pose2D(0, 0, 0), [WALL]))
+    grid.integrate(render_boxes(Pose2D(17.0, 0.0, 0.0), [((20.02, -2.0, 0.0), (20.2, 2.0, 2.0))]))
+    c = grid.config
+    occ = (grid.state == OCCUPIED).astype(np.uint8)
+    expected = cv2.dilate(occ, disk_kernel(c.robot_radius / c.resolution)).astype(bool)
+    np.testing.assert_array_equal(grid.lethal, expected)
+    assert (grid.inflated | ~grid.lethal).all() and (grid.inflated & ~grid.lethal).any()
+    r, c2 = grid.world_to_cell(np.array([2.76, 0.0]))  # 0.26 m from the wall: inside the margin only
+    assert grid.inflated[r, c2] and not grid.lethal[r, c2]
+    snap = grid.snapshot()
+    np.testing.assert_array_equal(snap.lethal, grid.lethal)
+    assert not snap.lethal.flags.writeable

@@ -175,3 +175,39 @@ def test_resending_the_same_goal_changes_nothing():
     assert nav.reached
     nav.set_goal(Goal(3.0, 2.0, tolerance=0.3))
     assert not nav.reached and nav.path_xy is None
+
+
+def _doorway_grid(gap_cells: int) -> GridSnapshot:
+    """A wall across the room at column 50 with one doorway ``gap_cells`` wide; lethal = radius 3.6 cells,
+    inflated = radius 4.6 cells (robot radius + margin, as the occupancy grid defaults)."""
+    s = open_room()
+    s[:, 50] = 1
+    s[50 - gap_cells // 2:50 - gap_cells // 2 + gap_cells, 50] = 0
+    occ = (s == 1).astype(np.uint8)
+    return GridSnapshot(state=s, inflated=cv2.dilate(occ, disk_kernel(4.6)).astype(bool),
+                        lethal=cv2.dilate(occ, disk_kernel(3.6)).astype(bool), explored=s != -1,
+                        origin=np.zeros(2), resolution=RES, version=1, stamp=0.0)
+
+
+def test_a_doorway_the_margin_closes_is_crossed_on_the_tight_fallback():
+    grid = _doorway_grid(8)  # 0.40 m: the 0.36 m robot fits, robot + 2 x 5 cm margin does not
+    assert grid.inflated[:, 50].all() and not grid.lethal[:, 50].all()
+    nav = Navigator()
+    nav.set_goal(Goal(4.0, 2.5, tolerance=0.25))
+    pose, actions = simulate_discrete(nav, grid, Pose2D(1.0, 2.5, 0.0), true_blocked=grid.lethal, steps=300)
+    assert nav.reached and np.hypot(pose.x - 4.0, pose.y - 2.5) <= 0.25
+    first = Navigator()
+    first.set_goal(Goal(4.0, 2.5, tolerance=0.25))
+    assert first.plan(grid, Pose2D(1.0, 2.5, 0.0)) and first.tight
+
+    strict = Navigator()
+    strict.config.tight_fallback = False
+    strict.set_goal(Goal(4.0, 2.5, tolerance=0.25))
+    assert strict.step(grid, Pose2D(1.0, 2.5, 0.0)) == DiscreteAction.STOP and strict.status == "no_path"
+
+
+def test_a_wide_doorway_keeps_the_margin():
+    grid = _doorway_grid(20)
+    nav = Navigator()
+    nav.set_goal(Goal(4.0, 2.5, tolerance=0.25))
+    assert nav.plan(grid, Pose2D(1.0, 2.5, 0.0)) and not nav.tight
