@@ -26,6 +26,8 @@ class SimConfig(BaseModel):
     tilt_deg: float = Field(30.0, gt=0.0, description="look_up/look_down angle")
     max_tilt_deg: float = Field(60.0, ge=0.0, description="limit of the camera pitch")
     robot_radius: float = Field(0.18, gt=0.0, description="robot disc radius (m)")
+    allow_sliding: bool = Field(True, description="a blocked move slides along the obstacle (Habitat-Sim's "
+                                "default) instead of stopping dead")
     success_distance: float = Field(1.0, ge=0.0, description="geodesic success radius (m)")
     max_steps: int = Field(500, gt=0, description="episode step limit")
     texture_noise: float = Field(0.12, ge=0.0, le=1.0,

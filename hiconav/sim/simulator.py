@@ -3,9 +3,11 @@ with collisions against the navigable grid, and RGB-D + instance observations.
 
 Collision model: the robot is a disc of ``robot_radius``; its centre may only be where the
 cell's clearance (``geodesic.clearance``) is at least the radius, so the disc never overlaps a
-wall or object cell. Motion is integrated in sub-steps of at most half a cell; at the first
-sub-step that would leave free space the robot stops there (no sliding) and ``collided`` is
-set for that step. Simulated time advances ``ACTION_SECONDS`` per discrete action and ``dt``
+wall or object cell. Motion is integrated in sub-steps of at most half a cell; a sub-step that
+would leave free space sets ``collided`` for that step and, with ``allow_sliding`` (Habitat-
+Sim's default), slides: the robot takes the sub-step's x or y component alone (the longer one
+first) when that stays free, so it glides along a wall met at an angle instead of stopping dead;
+otherwise (or without sliding) it stops there. Simulated time advances ``ACTION_SECONDS`` per discrete action and ``dt``
 per velocity step. This module moves the robot and renders; it must not plan or decide.
 """
 
@@ -113,16 +115,31 @@ class Simulator:
         n = max(1, math.ceil(abs(distance) / (self.house.nav.resolution / 2.0)))
         d = np.array([math.cos(yaw), math.sin(yaw)]) * (distance / n)
         xy = self.pose.xy
-        moved = 0
+        start = xy
+        blocked = False
         for _ in range(n):
             nxt = xy + d
             if not self.is_free(nxt):
-                break
+                blocked = True
+                nxt = self._slide(xy, d) if self.config.allow_sliding else None
+                if nxt is None:
+                    break
             xy = nxt
-            moved += 1
-        self.path_length += abs(distance) * moved / n
+        self.path_length += float(np.hypot(*(xy - start)))
         self.pose = Pose2D(float(xy[0]), float(xy[1]), self.pose.yaw)
-        return moved < n
+        return blocked
+
+    def _slide(self, xy: np.ndarray, d: np.ndarray) -> np.ndarray | None:
+        """The free point reached by the x or the y component of sub-step ``d`` alone, or None."""
+        axes = (0, 1) if abs(d[0]) >= abs(d[1]) else (1, 0)
+        for k in axes:
+            if abs(d[k]) < 1e-9:
+                continue
+            nxt = xy.copy()
+            nxt[k] += d[k]
+            if self.is_free(nxt):
+                return nxt
+        return None
 
     def step(self, action: DiscreteAction) -> Frame:
         """Apply one discrete action (Habitat semantics) and return the new observation."""

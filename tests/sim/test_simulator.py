@@ -54,6 +54,21 @@ def test_forward_into_a_wall_stops_before_it_and_flags_collision():
     assert sim.pose.x < 5.95
 
 
+def test_a_wall_met_at_an_angle_is_slid_along_unless_sliding_is_off():
+    for sliding in (True, False):
+        sim = _no_render(Simulator(box_room(6.0), SimConfig(allow_sliding=sliding)))
+        sim.reset(Pose2D(5.6, 3.0, math.radians(60)))  # 0.17 m from the wall face at x = 5.95
+        for _ in range(4):
+            sim.step(A.MOVE_FORWARD)
+        assert sim.collided
+        assert sim.pose.x + 0.18 <= 5.95 + 0.05  # never into the wall
+        if sliding:
+            assert sim.pose.y > 3.6  # glided along the wall, losing only the blocked component
+            assert sim.path_length == pytest.approx(np.hypot(sim.pose.x - 5.6, sim.pose.y - 3.0), abs=0.1)
+        else:
+            assert sim.pose.y < 3.3  # stopped dead at the first blocked sub-step
+
+
 def test_never_through_a_thin_wall_or_object():
     walls = [Wall((3.0, 0.0), (3.0, 6.0), 2.5, 0.1)]  # splits the room in two
     house = box_room(6.0, [obj(0, "sofa", (1.5, 1.5, 0.4), (0.8, 0.8, 0.8))], walls)
