@@ -5,8 +5,12 @@ scan speckle, see ``clean_floor``), channels 1-15
 the categories in ``CHANNEL_CATEGORIES``. Every 8-connected component of a category channel
 becomes one object instance, extruded between a typical bottom and top height per category
 (``EXTRUSION``; footprints have no heights in the source). All other (non-navigable, non-object)
-cells are walls/clutter of the full wall height; only their faces that border the floor or an
-object are rendered (merged along straight runs), which keeps the mesh small.
+cells are split by ``split_clutter``: the ones connected to the map's outside are walls of the
+full wall height; small islands enclosed by floor are unlabelled furniture (tables, cabinets,
+the clutter around a dining set), extruded to ``CLUTTER_HEIGHT`` with a top face. Only their
+faces that border the floor or an object are rendered (merged along straight runs), which keeps
+the mesh small. (Drawn as full-height walls, those islands hid the chairs and plants standing
+inside them from every viewpoint, though a robot in the real home sees over a table.)
 
 Coordinates (data README): a Habitat position (x_h, y_h, z_h) (y up, right-handed) lies in
 cell row = int((x_h - origin[1]/100) * 20), col = int((z_h - origin[0]/100) * 20). Our grid
@@ -56,6 +60,24 @@ EXTRUSION = {
 }
 EIGHT = np.ones((3, 3), dtype=bool)
 SPECKLE_CELLS = 30  # enclosed non-floor holes smaller than this (0.075 m^2) are scan noise
+CLUTTER_HEIGHT = 0.8  # m: unlabelled furniture islands (assumption: table / cabinet height)
+MAX_FURNITURE_M2 = 6.0  # larger enclosed islands are walls (a room's inner walls, a stairwell)
+
+
+def split_clutter(clutter: np.ndarray, res: float = RESOLUTION) -> tuple[np.ndarray, np.ndarray]:
+    """(walls, furniture) masks of the non-floor, non-object cells: an 8-connected component is
+    furniture when it touches no map edge (enclosed by floor) and covers at most
+    ``MAX_FURNITURE_M2``; everything else is wall."""
+    labels, n = ndimage.label(clutter, structure=EIGHT)
+    if n == 0:
+        return clutter.copy(), np.zeros_like(clutter)
+    sizes = np.bincount(labels.ravel(), minlength=n + 1)
+    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+    furniture_label = sizes * res * res <= MAX_FURNITURE_M2
+    furniture_label[edge] = False
+    furniture_label[0] = False
+    furniture = furniture_label[labels]
+    return clutter & ~furniture, furniture
 
 
 @lru_cache(maxsize=2)
@@ -186,9 +208,11 @@ def load_gibson(scene: str, floor: int, data_dir: Path) -> House:
     # Walls / clutter: every other cell, drawn as the vertical faces that border the floor
     # or an object (the only faces visible from the floor; the ceiling covers their tops).
     nav_mask = clean_floor(nav_mask, any_object)
-    clutter = ~(nav_mask | any_object)
-    quads.append(mask_side_quads(clutter, origin, RESOLUTION, 0.0, WALL_HEIGHT,
+    walls, furniture = split_clutter(~(nav_mask | any_object))
+    quads.append(mask_side_quads(walls, origin, RESOLUTION, 0.0, WALL_HEIGHT,
                                  (0.8, 0.78, 0.74), material="wall"))
+    quads.append(mask_side_quads(furniture, origin, RESOLUTION, 0.0, CLUTTER_HEIGHT,
+                                 (0.55, 0.45, 0.35), material="wall", top=True))
     nav = NavGrid(clean_floor(nav_mask, any_object), origin, RESOLUTION)
     name = f"gibson:{scene}" if floor == 0 else f"gibson:{scene}/{floor}"
     return House(name=name, objects=objects, nav=nav, rooms=[], boxes=[],

@@ -76,3 +76,22 @@ def test_habitat_yaw_matches_forward_vector():
     # 90 deg about +y_h turns -z_h into -x_h -> world (0, -1) -> -pi/2.
     s = np.sin(np.pi / 4)
     assert np.isclose(habitat_yaw([0, s, 0, s]), -np.pi / 2)
+
+
+def test_enclosed_small_clutter_is_low_furniture_and_the_rest_is_wall():
+    """Islands enclosed by floor (a table with chairs around it) must not be drawn as 2.6 m walls:
+    the robot would never see the chairs standing in them."""
+    from hiconav.sim.gibson import split_clutter
+
+    clutter = np.zeros((100, 120), dtype=bool)
+    clutter[0, :] = clutter[-1, :] = clutter[:, 0] = clutter[:, -1] = True  # the outside
+    clutter[40:50, 40:60] = True  # 0.5 m x 1 m island: furniture
+    clutter[5:95, 100:120] = True  # touches the map edge: wall
+    walls, furniture = split_clutter(clutter)
+    assert furniture[45, 50] and not walls[45, 50]
+    assert walls[0, 5] and walls[50, 110] and not furniture[50, 110]
+    assert not (walls & furniture).any() and ((walls | furniture) == clutter).all()
+    big = np.zeros((200, 200), dtype=bool)
+    big[20:180, 20:180] = True  # 64 m^2 enclosed: a block of rooms' walls, not furniture
+    walls, furniture = split_clutter(big)
+    assert walls[100, 100] and not furniture.any()
