@@ -29,6 +29,11 @@ class DiscreteConfig(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     turn_tolerance_deg: float = Field(15.0, gt=0.0, description="turn until the heading error is below this")
+    forward_tolerance_deg: float = Field(
+        35.0, gt=0.0, le=90.0,
+        description="keep going forward up to this heading error while the step stays clear and near the path "
+        "(a turn costs a whole step; without this the robot zig-zags left-forward-right-forward)",
+    )
     forward_step_m: float = Field(0.25, gt=0.0)
     turn_deg: float = Field(30.0, gt=0.0)
     lookahead_m: float = Field(0.4, gt=0.0, description="steer toward the path point this far ahead")

@@ -293,7 +293,40 @@ class Navigator:
         )
         if np.hypot(*(target - pose.xy)) < 1e-6:
             target = self.path_xy[-1]
-        return self._act(to_discrete(pose, target, cfg.discrete.turn_tolerance_deg), pose)
+        return self._act(self._discrete_action(grid, pose, target), pose)
+
+    def _discrete_action(self, grid: GridLike, pose: Pose2D, target: np.ndarray) -> DiscreteAction:
+        """Turn toward ``target`` until within the turn tolerance, then go forward; keep going
+        forward up to ``forward_tolerance_deg`` off while the step is clear (known free, outside the
+        inflation) and ends near the path. A 30-degree turn costs a whole step, so turning as soon as
+        the error passed 15 degrees made the robot zig-zag, one turn per forward step."""
+        dc = self.config.discrete
+        d = np.asarray(target, dtype=np.float64) - pose.xy
+        err = abs(wrap_angle(math.atan2(d[1], d[0]) - pose.yaw))
+        if err <= math.radians(dc.turn_tolerance_deg) or (
+                not self.tight and self._stuck == 0 and err <= math.radians(dc.forward_tolerance_deg)
+                and self._forward_clear(grid, pose)):
+            return DiscreteAction.MOVE_FORWARD
+        return to_discrete(pose, target, dc.turn_tolerance_deg)
+
+    def _forward_clear(self, grid: GridLike, pose: Pose2D) -> bool:
+        step = self.config.discrete.forward_step_m
+        heading = np.array([math.cos(pose.yaw), math.sin(pose.yaw)])
+        pts = pose.xy[None, :] + np.array([[0.5], [1.0], [1.5]]) * step * heading[None, :]
+        rc = grid.world_to_cell(pts)
+        h, w = grid.state.shape
+        if not ((rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)).all():
+            return False
+        if (np.asarray(grid.inflated)[rc[:, 0], rc[:, 1]] | (np.asarray(grid.state)[rc[:, 0], rc[:, 1]] != 0)).any():
+            return False
+        for x, y, r in self._virtual:  # where the robot got stuck before (glass, unmapped clutter)
+            if (np.hypot(pts[:, 0] - x, pts[:, 1] - y) <= r + 0.5 * step).any():
+                return False
+        path = self._dense_xy if self._dense_xy is not None and len(self._dense_xy) else self.path_xy
+        if path is None:
+            return False
+        end = pose.xy + step * heading
+        return float(np.min(np.hypot(*(path - end).T))) <= 0.3
 
     def _act(self, action: DiscreteAction, pose: Pose2D) -> DiscreteAction:
         self._last_action = action

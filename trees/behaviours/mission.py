@@ -237,7 +237,8 @@ class VerifyTarget(_GoToObject):
     while the robot is close and the candidate's centre is inside the camera's field of view, the
     target-labelled object nodes at the candidate's place must gain ``min_fresh_views`` new
     observations and be detected in at least ``min_detection_rate`` of those frames (the frames
-    the memory integrated, counted by its version). A real object is detected in most frames that show it; a
+    the memory integrated into its graph, i.e. its anchors, counted by its version; the robot
+    glances 35 degrees left and right of the target so that each glance makes one). A real object is detected in most frames that show it; a
     spurious box lands at a random place in a random frame, so one that happened to fall on the
     candidate's place is outvoted by the frames that show nothing there. A candidate seen in too
     few of ``max_view_frames`` frames, or that vanishes from memory or changes label, is rejected
@@ -254,7 +255,7 @@ class VerifyTarget(_GoToObject):
         "min_fresh_views": Param(int, 2, minimum=0, maximum=100),
         "min_detection_rate": Param(float, 0.5, minimum=0.0, maximum=1.0,
                                     doc="fresh views per frame with the candidate in view"),
-        "max_view_frames": Param(int, 30, minimum=1, maximum=10000,
+        "max_view_frames": Param(int, 8, minimum=1, maximum=10000,
                                  doc="frames in view after which a rarely detected candidate is rejected"),
         "hfov_deg": Param(float, 79.0, minimum=1.0, maximum=360.0, doc="the camera's horizontal field of view"),
         "min_confidence": Param(float, 0.3, minimum=0.0, maximum=1.0),
@@ -266,7 +267,9 @@ class VerifyTarget(_GoToObject):
     }
     WRITES = ("target",)
     READS = ()
-    _GLANCES = (30.0, -30.0, 0.0)  # degrees from facing the target
+    # degrees from facing the target: 70 degrees apart, so that each glance passes the memory's
+    # anchor gate (delta_theta = 45 deg) and adds a view, while the target stays in the field of view
+    _GLANCES = (35.0, -35.0)
 
     def initialise(self) -> None:
         self._start = self.context.now()
