@@ -72,7 +72,7 @@ class GridLike(Protocol):
 
     state: np.ndarray  # (H, W) int8: -1 unknown, 0 free, 1 occupied
     inflated: np.ndarray  # (H, W) bool: occupied dilated by the robot radius + inflation margin
-    lethal: np.ndarray  # (H, W) bool: occupied dilated by the robot radius alone (no margin)
+    lethal: np.ndarray  # (H, W) bool: occupied dilated by the robot radius alone (no margin, less the pad)
     origin: np.ndarray  # (2,) world xy of the corner of cell (0, 0)
     resolution: float  # m per cell
 
@@ -154,7 +154,8 @@ class OccupancyGrid(_OccupancyFields):
 
     Public attributes (read them, do not write them): state (H, W) int8 (-1 unknown, 0 free,
     1 occupied), inflated (H, W) bool (robot radius + margin), lethal (H, W) bool (robot radius
-    only: the robot centre cannot be there at all), explored (H, W) bool, origin (2,) world xy of the corner of
+    only, less the ``obstacle_pad`` the marking already adds: the robot centre cannot be there at
+    all), explored (H, W) bool, origin (2,) world xy of the corner of
     cell (0, 0), resolution (m). Cell (i, j) has its centre at x = ox + (j + 0.5) * res,
     y = oy + (i + 0.5) * res.
     """
@@ -174,7 +175,9 @@ class OccupancyGrid(_OccupancyFields):
         c = self.config
         self._inflate_cells = (c.robot_radius + c.inflation_margin) / self.resolution
         self._kernel = disk_kernel(self._inflate_cells)
-        self._lethal_kernel = disk_kernel(c.robot_radius / self.resolution)
+        # an obstacle point already marks the cells within obstacle_pad cells of it, so marked cells
+        # reach that far past the surface: the lethal layer grows them by the rest of the radius only
+        self._lethal_kernel = disk_kernel(max(c.robot_radius / self.resolution - c.obstacle_pad, 0.0))
         self._footprint = disk_kernel(0.8 * c.robot_radius / self.resolution).astype(bool)
 
     # ------------------------------------------------------------------ grid geometry

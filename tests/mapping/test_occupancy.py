@@ -228,7 +228,7 @@ def test_lethal_layer_is_the_robot_radius_alone_and_travels_with_snapshots():
     grid.integrate(render_boxes(Pose2D(17.0, 0.0, 0.0), [((20.02, -2.0, 0.0), (20.2, 2.0, 2.0))]))
     c = grid.config
     occ = (grid.state == OCCUPIED).astype(np.uint8)
-    expected = cv2.dilate(occ, disk_kernel(c.robot_radius / c.resolution)).astype(bool)
+    expected = cv2.dilate(occ, disk_kernel(c.robot_radius / c.resolution - c.obstacle_pad)).astype(bool)
     np.testing.assert_array_equal(grid.lethal, expected)
     assert (grid.inflated | ~grid.lethal).all() and (grid.inflated & ~grid.lethal).any()
     r, c2 = grid.world_to_cell(np.array([2.76, 0.0]))  # 0.26 m from the wall: inside the margin only
