@@ -76,6 +76,9 @@ class MissionContext:
     stop_requested: bool = False
     events: list[str] = field(default_factory=list)
     alerts: list[Any] = field(default_factory=list)  # HealthAlert messages from monitor actors
+    # clock time a frontier to explore was last known; shared by every Explore instance, so a retried
+    # Explore does not wait its idle time again once the map has been explored out
+    last_frontier_time: float | None = None
 
     # -- time and pose -------------------------------------------------------------------------
     def now(self) -> float:

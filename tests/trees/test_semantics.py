@@ -270,3 +270,20 @@ def test_find_and_return_goes_home_on_a_health_alert():
     assert explore.terminations[-1] == S.INVALID
     assert _node(tree, "ReturnToStart").status == S.RUNNING
     tree.stop()
+
+
+def test_a_retried_explore_fails_at_once_when_the_map_is_explored_out(tmp_path):
+    """The idle clock belongs to the mission: the Retry above Explore must not make the robot idle
+    (and turn around) for max_idle_s again on every retry once no frontier is left."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan()
+    tree = MissionTree(_write(tmp_path, "root:\n  Retry:\n    num_failures: 50\n    child:\n"
+                                        "      Explore: {max_idle_s: 3}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    clock.t = 3.5
+    ticks = 1
+    while tree.tick() == S.RUNNING:
+        ticks += 1
+        assert ticks < 60
+    assert tree.root.status == S.FAILURE and clock.t == 3.5  # no simulated time spent idling again

@@ -132,7 +132,9 @@ class TargetConfirmed(MissionBehaviour):
 @register_behaviour()
 class Explore(MissionBehaviour):
     """Follow the exploration plan: go to the first frontier of the WTRP order, re-planned as the
-    map grows; FAILURE when no frontier is left for ``max_idle_s``."""
+    map grows; FAILURE when no frontier is left for ``max_idle_s``. The idle clock is the mission
+    context's (``last_frontier_time``), so an Explore retried after the map was explored out fails
+    at once instead of idling (and turning) again for every retry."""
 
     PARAMS = {
         "max_idle_s": Param(float, 15.0, minimum=0.0, maximum=3600.0, doc="no frontier for this long: fail"),
@@ -145,7 +147,8 @@ class Explore(MissionBehaviour):
         self._seq: int | None = None
         self._frontier: int | None = None
         self._goal_xy: np.ndarray | None = None
-        self._last_progress = self.context.now()
+        if self.context.last_frontier_time is None:
+            self.context.last_frontier_time = self.context.now()
         self._visited: set[int] = set()
         self._looks = 0
 
@@ -175,19 +178,20 @@ class Explore(MissionBehaviour):
             if self._frontier is not None and self._seq is not None:
                 ctx.send_goal(None)
                 self._seq = None
+            since = now if ctx.last_frontier_time is None else float(ctx.last_frontier_time)
+            if now - since > self.param("max_idle_s"):
+                self.feedback_message = "no frontier left"
+                return Status.FAILURE
             pose = ctx.pose
             if self._seq is None and pose is not None and self._looks < self.param("look_turns"):
                 # no frontier in view: turn in place (a quarter turn per look) to see around
                 self._looks += 1
                 self._frontier, self._goal_xy = None, None
                 self._seq = ctx.send_goal(Goal(pose.x, pose.y, wrap_angle(pose.yaw + math.pi / 2), 0.5, "look"))
-                self._last_progress = now
-            if now - self._last_progress > self.param("max_idle_s"):
-                self.feedback_message = "no frontier left"
-                return Status.FAILURE
+                ctx.last_frontier_time = now  # looking around is progress
             self.feedback_message = "looking around" if self._seq is not None else "waiting for a frontier"
             return Status.RUNNING
-        self._last_progress = now
+        ctx.last_frontier_time = now
         self._looks = 0
         fid, xy = pick
         moved = self._goal_xy is None or float(np.hypot(*(xy - self._goal_xy))) > self.param("switch_distance")
