@@ -151,30 +151,38 @@ root:
     assert _node(tree, "Explore").status == S.RUNNING  # rejected candidate no longer confirms
 
 
-def test_verify_confirms_with_fresh_views_when_close(tmp_path):
-    clock = Clock()
+FACING_BED = Pose2D(4.0, 4.0, math.pi / 4)  # the bed at (5, 5) is straight ahead, 1.4 m away
+
+
+def _verify_tree(tmp_path, clock: Clock, params: str, pose: Pose2D = FACING_BED):
+    """A context with one bed node (n_obs 1, memory version 1) and TargetConfirmed -> VerifyTarget."""
     ctx = _ctx(clock)
-    ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=4)], version=1)
+    ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0, n_obs=1)], version=1)
     tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - VerifyTarget: {min_fresh_views: 2}\n"), ctx)
+                                        f"      - VerifyTarget: {{{params}}}\n"), ctx)
+    return ctx, tree
+
+
+def _view(ctx, n_obs: int, version: int, pose: Pose2D = FACING_BED) -> None:
+    ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0, n_obs=n_obs)], version=version)
+
+
+def test_verify_confirms_with_fresh_views_when_close(tmp_path):
+    ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2")
     assert tree.tick() == S.RUNNING
-    ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=5)], version=2)
+    _view(ctx, 2, 2)
     assert tree.tick() == S.RUNNING
-    ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=6)], version=3)
+    _view(ctx, 3, 3)
     assert tree.tick() == S.SUCCESS
 
 
 def test_verify_rejects_a_candidate_rarely_detected_while_in_view(tmp_path):
     """A spurious box that fell on a place once is outvoted by the frames that show nothing there."""
-    clock = Clock()
-    ctx = _ctx(clock)
-    ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=1)], version=1)
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - VerifyTarget: {min_fresh_views: 2, max_view_frames: 10}\n"), ctx)
+    ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 10")
     n_obs = 1
     for version in range(2, 12):
         n_obs += version in (4, 9)  # two fresh views in ten frames: below the 50% detection rate
-        ctx.world = world(Pose2D(4.0, 4.0, math.pi / 4), [obj(3, "bed", 5.0, 5.0, n_obs=n_obs)], version=version)
+        _view(ctx, n_obs, version)
         status = tree.tick()
     assert status == S.FAILURE
     assert ctx.rejections and ctx.rejections[-1][0] == 3 and "2 of 10 frames" in ctx.rejections[-1][1]
@@ -182,14 +190,10 @@ def test_verify_rejects_a_candidate_rarely_detected_while_in_view(tmp_path):
 
 
 def test_verify_counts_only_frames_with_the_candidate_in_view(tmp_path):
-    clock = Clock()
-    ctx = _ctx(clock)
     away = Pose2D(4.0, 4.0, math.pi)  # the bed is behind the robot
-    ctx.world = world(away, [obj(3, "bed", 5.0, 5.0, n_obs=1)], version=1)
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - VerifyTarget: {min_fresh_views: 2, max_view_frames: 5}\n"), ctx)
+    ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 5", away)
     for version in range(2, 20):
-        ctx.world = world(away, [obj(3, "bed", 5.0, 5.0, n_obs=1)], version=version)
+        _view(ctx, 1, version, away)
         assert tree.tick() == S.RUNNING  # not in view: neither confirmed nor rejected
 
 
