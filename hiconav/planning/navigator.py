@@ -37,8 +37,8 @@ log = logging.getLogger(__name__)
 
 def blocked_cells(grid: GridLike, *, through_unknown: bool = False, tight: bool = False) -> np.ndarray:
     """(H, W) bool cells the robot centre must not enter: inflated obstacles (+ unknown cells);
-    ``tight``: obstacles grown by the robot radius alone (``lethal_mask``), for passages the
-    inflation margin closes."""
+    ``tight``: the lethal layer instead (obstacles grown by the robot radius, no margin;
+    ``lethal_mask``), for passages the inflation margin closes."""
     blocked = np.array(lethal_mask(grid) if tight else grid.inflated, dtype=bool, copy=True)
     if not through_unknown:
         blocked |= grid.state == -1
@@ -153,7 +153,7 @@ class Navigator:
 
         The path keeps the inflation margin from obstacles when it can; when no such path exists
         (a doorway or a gap between furniture narrower than the robot plus twice the margin) and
-        ``tight_fallback`` is on, it plans again with the robot radius alone (``tight``)."""
+        ``tight_fallback`` is on, it plans again on the lethal layer (``tight``)."""
         self._ticks_since_plan = 0
         self.n_plans += 1
         if self.goal is None:
@@ -165,7 +165,7 @@ class Navigator:
             self.path_xy, self._dense_xy, self.status = None, None, "no_path"
             return False
         for tight in (False, True) if self.config.tight_fallback else (False,):
-            found = self._plan_on(grid, pose, start, goal, tight)
+            found = self._plan_on(grid, start, goal, tight)
             if found is not None:
                 blocked, cells = found
                 self.tight = tight
@@ -181,7 +181,7 @@ class Navigator:
         self.status = "following"
         return True
 
-    def _plan_on(self, grid: GridLike, pose: Pose2D, start: np.ndarray, goal: np.ndarray,
+    def _plan_on(self, grid: GridLike, start: np.ndarray, goal: np.ndarray,
                  tight: bool) -> tuple[np.ndarray, np.ndarray] | None:
         """(blocked mask, A* cells) of a path on the normal or the ``tight`` mask, or None."""
         res = grid.resolution
