@@ -291,3 +291,24 @@ def test_a_retried_explore_fails_at_once_when_the_map_is_explored_out(tmp_path):
         ticks += 1
         assert ticks < 60
     assert tree.root.status == S.FAILURE and clock.t == 3.5  # no simulated time spent idling again
+
+
+def test_an_unreachable_candidate_is_deferred_by_approach_so_exploration_goes_on(tmp_path):
+    """'No reachable approach cell' used to end the mission; now the candidate waits defer_s."""
+    import numpy as np
+
+    from .fakes import FakeGrid
+
+    clock = Clock()
+    ctx = _ctx(clock)
+    state = np.full((100, 100), -1, dtype=np.int8)  # nothing known near the bed
+    state[10:30, 10:30] = 0
+    grid = FakeGrid(state, np.zeros_like(state, dtype=bool))
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 8.0, 8.0)], grid=grid)
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - Approach: {distance: 0.8, defer_s: 30}\n"), ctx)
+    assert tree.tick() == S.FAILURE
+    assert ctx.excluded(3) and 3 not in ctx.rejected  # deferred, not rejected for good
+    assert "approach" in ctx.rejections[-1][1]
+    clock.t = 31.0
+    assert not ctx.excluded(3)
