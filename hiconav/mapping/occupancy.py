@@ -402,10 +402,9 @@ class OccupancyGrid(_OccupancyFields):
         dr0, dc0 = max(0, er0 - kr), max(0, ec0 - kr)
         dr1, dc1 = min(h, er1 + kr), min(w, ec1 + kr)
         occ = (self.state[dr0:dr1, dc0:dc1] == OCCUPIED).astype(np.uint8)
-        dil = cv2.dilate(occ, self._kernel, borderType=cv2.BORDER_CONSTANT, borderValue=0)
-        self.inflated[er0:er1, ec0:ec1] = dil[er0 - dr0 : er1 - dr0, ec0 - dc0 : ec1 - dc0].astype(bool)
-        dil = cv2.dilate(occ, self._lethal_kernel, borderType=cv2.BORDER_CONSTANT, borderValue=0)
-        self.lethal[er0:er1, ec0:ec1] = dil[er0 - dr0 : er1 - dr0, ec0 - dc0 : ec1 - dc0].astype(bool)
+        for layer, kernel in ((self.inflated, self._kernel), (self.lethal, self._lethal_kernel)):
+            dil = cv2.dilate(occ, kernel, borderType=cv2.BORDER_CONSTANT, borderValue=0)
+            layer[er0:er1, ec0:ec1] = dil[er0 - dr0 : er1 - dr0, ec0 - dc0 : ec1 - dc0].astype(bool)
 
         self.version += 1
         self.stamp = float(frame.stamp)

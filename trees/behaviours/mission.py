@@ -178,8 +178,7 @@ class Explore(MissionBehaviour):
             if self._frontier is not None and self._seq is not None:
                 ctx.send_goal(None)
                 self._seq = None
-            since = now if ctx.last_frontier_time is None else float(ctx.last_frontier_time)
-            if now - since > self.param("max_idle_s"):
+            if now - ctx.last_frontier_time > self.param("max_idle_s"):  # set in initialise
                 self.feedback_message = "no frontier left"
                 return Status.FAILURE
             pose = ctx.pose
