@@ -105,3 +105,17 @@ def test_unknown_runner_fails_once_before_any_episode(tmp_path) -> None:
         evaluate(make_specs(2), tmp_path, EvalConfig(runner="hiconav.nosuch:run", workers=0, progress=False))
     path = tmp_path / "episodes.jsonl"
     assert not path.exists() or not path.read_text()
+
+
+def test_worker_processes_render_in_their_own_thread_unless_the_user_says_otherwise(monkeypatch) -> None:
+    from hiconav.eval import runner
+
+    for name in runner.WORKER_THREAD_ENV:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")
+    runner._init_worker()
+    import os
+
+    assert os.environ["LP_NUM_THREADS"] == "0"  # llvmpipe: no render threads beside the worker
+    assert os.environ["NUMBA_NUM_THREADS"] == "1"
+    assert os.environ["OMP_NUM_THREADS"] == "3"  # the user's value wins
