@@ -79,6 +79,10 @@ class MissionContext:
     # clock time a frontier to explore was last known; shared by every Explore instance, so a retried
     # Explore does not wait its idle time again once the map has been explored out
     last_frontier_time: float | None = None
+    # frontier viewpoints (x, y) the robot reached while their frontier stayed: the camera cannot
+    # see that frontier from there (floor below its field of view, walls nearer than its minimum
+    # depth), so going back would only repeat the visit; shared by every Explore instance
+    spent_viewpoints: list[tuple[float, float]] = field(default_factory=list)
 
     # -- time and pose -------------------------------------------------------------------------
     def now(self) -> float:

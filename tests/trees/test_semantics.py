@@ -312,3 +312,60 @@ def test_an_unreachable_candidate_is_deferred_by_approach_so_exploration_goes_on
     assert "approach" in ctx.rejections[-1][1]
     clock.t = 31.0
     assert not ctx.excluded(3)
+
+
+def _plan_at(stamp: float, *frontiers: tuple[int, tuple[float, float]]):
+    """A plan made at ``stamp`` with frontiers (id, viewpoint), in WTRP order."""
+    from dataclasses import replace
+
+    import numpy as np
+    from hiconav.mapping.frontiers import Frontier
+
+    fs = tuple(Frontier(i, np.array(p), np.array(p), 10) for i, p in frontiers)
+    return replace(plan(), plan=type(plan((0.0, 0.0)).plan)(fs[0], tuple(f.id for f in fs)), frontiers=fs,
+                   stamp=stamp)
+
+
+def test_explore_skips_a_frontier_its_visit_did_not_clear_even_under_a_new_id(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = _plan_at(0.0, (0, (8.0, 8.0)), (1, (1.0, 8.0)))
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {}\n"), ctx)
+    tree.tick()
+    first = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    assert first.goal.ref_id == 0
+    clock.t = 5.0
+    ctx.nav = NavStatus(first.seq, "reached", 0.0)
+    # a plan older than the visit does not decide: the frontier may still clear
+    ctx.plan = _plan_at(4.0, (7, (8.1, 8.0)), (8, (1.0, 8.0)))
+    tree.tick()
+    assert ctx.spent_viewpoints == []
+    # the first plan after the visit still has a frontier there (renumbered): the spot is spent
+    clock.t = 6.0
+    ctx.plan = _plan_at(5.5, (9, (8.1, 8.0)), (10, (1.0, 8.0)))
+    tree.tick()
+    assert ctx.spent_viewpoints == [(8.0, 8.0)]
+    last = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    assert last.goal.ref_id == 10
+    # a retried Explore (a new instance) remembers it through the context
+    tree2 = MissionTree(_write(tmp_path, "root:\n  Explore: {}\n"), ctx)
+    ctx.plan = _plan_at(7.0, (11, (8.0, 8.2)), (12, (1.0, 8.0)))
+    tree2.tick()
+    assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.ref_id == 12
+
+
+def test_explore_does_not_spend_a_viewpoint_whose_frontier_cleared(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = _plan_at(0.0, (0, (8.0, 8.0)), (1, (1.0, 8.0)))
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {}\n"), ctx)
+    tree.tick()
+    first = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    clock.t = 5.0
+    ctx.nav = NavStatus(first.seq, "reached", 0.0)
+    tree.tick()
+    clock.t = 6.0
+    ctx.plan = _plan_at(5.5, (3, (9.5, 8.0)), (4, (1.0, 8.0)))  # the frontier moved on, 1.5 m
+    tree.tick()
+    assert ctx.spent_viewpoints == []
+    assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.ref_id == 3

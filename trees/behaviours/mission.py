@@ -134,13 +134,22 @@ class Explore(MissionBehaviour):
     """Follow the exploration plan: go to the first frontier of the WTRP order, re-planned as the
     map grows; FAILURE when no frontier is left for ``max_idle_s``. The idle clock is the mission
     context's (``last_frontier_time``), so an Explore retried after the map was explored out fails
-    at once instead of idling (and turning) again for every retry."""
+    at once instead of idling (and turning) again for every retry.
+
+    A frontier can outlive a visit: from its viewpoint the camera may not see it (the floor
+    close to the robot is below the field of view, a wall nearer than the minimum depth reads
+    nothing). When the first plan made after reaching a viewpoint still has a frontier viewpoint
+    within ``spent_radius`` of it, that spot is spent (``context.spent_viewpoints``): frontiers
+    seen from there are skipped for the rest of the mission, instead of being reached, looked
+    at and chosen again, under a new frontier id, for hundreds of steps."""
 
     PARAMS = {
         "max_idle_s": Param(float, 15.0, minimum=0.0, maximum=3600.0, doc="no frontier for this long: fail"),
         "goal_tolerance": Param(float, 0.3, minimum=0.05, maximum=5.0),
         "switch_distance": Param(float, 0.5, minimum=0.0, maximum=10.0, doc="re-send a goal that moved this far"),
         "look_turns": Param(int, 4, minimum=0, maximum=100, doc="quarter turns in place when no frontier is known"),
+        "spent_radius": Param(float, 0.4, minimum=0.0, maximum=5.0,
+                              doc="a frontier viewpoint this near a reached one that did not clear it is skipped"),
     }
 
     def initialise(self) -> None:
@@ -151,6 +160,29 @@ class Explore(MissionBehaviour):
             self.context.last_frontier_time = self.context.now()
         self._visited: set[int] = set()
         self._looks = 0
+        self._reached: list[tuple[np.ndarray, float]] = []  # viewpoint, clock time: awaiting a newer plan
+
+    def _spent(self, xy: np.ndarray) -> bool:
+        r = self.param("spent_radius")
+        return any(math.hypot(xy[0] - sx, xy[1] - sy) <= r for sx, sy in self.context.spent_viewpoints)
+
+    def _settle_reached(self) -> None:
+        """Mark reached viewpoints as spent once a plan made after the visit still shows a
+        frontier viewpoint near them."""
+        msg = self.context.plan
+        if msg is None or not self._reached:
+            return
+        r = self.param("spent_radius")
+        views = np.array([f.viewpoint for f in msg.frontiers], dtype=np.float64).reshape(-1, 2)
+        waiting = []
+        for xy, t in self._reached:
+            if msg.stamp <= t:
+                waiting.append((xy, t))
+            elif len(views) and float(np.min(np.hypot(*(views - xy).T))) <= r:
+                self.context.spent_viewpoints.append((float(xy[0]), float(xy[1])))
+                self.context.events.append(f"{self.context.now():.2f} frontier viewpoint "
+                                           f"({xy[0]:.2f}, {xy[1]:.2f}) spent: reached, not cleared")
+        self._reached = waiting
 
     def _pick(self) -> tuple[int, np.ndarray] | None:
         msg = self.context.plan
@@ -163,16 +195,22 @@ class Explore(MissionBehaviour):
             order.insert(0, goal.id)
         for fid in order:
             if fid in frontiers and fid not in self._visited:
-                return fid, np.asarray(frontiers[fid].viewpoint, dtype=np.float64)
+                xy = np.asarray(frontiers[fid].viewpoint, dtype=np.float64)
+                if not self._spent(xy):
+                    return fid, xy
         return None
 
     def update(self) -> Status:
         ctx = self.context
         now = ctx.now()
-        if self._seq is not None and ctx.nav_state(self._seq) in ("reached", "failed"):
+        state = None if self._seq is None else ctx.nav_state(self._seq)
+        if state in ("reached", "failed"):
             if self._frontier is not None:
                 self._visited.add(self._frontier)  # reached but still a frontier, or unreachable: move on
+                if state == "reached" and self._goal_xy is not None:
+                    self._reached.append((self._goal_xy, now))
             self._seq = None
+        self._settle_reached()
         pick = self._pick()
         if pick is None:
             if self._frontier is not None and self._seq is not None:
