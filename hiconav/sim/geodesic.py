@@ -6,11 +6,14 @@ nearest non-navigable cell, minus half a cell) is at least the robot radius: tha
 and never cut a corner (a diagonal step needs both orthogonal neighbours traversable).
 
 The distance to a goal object is one multi-source Dijkstra run: every traversable cell within
-``VIEW_RADIUS`` (1.0 m, Euclidean) of the object's footprint is a *view point* (as Habitat's
-ObjectNav goal view points) and a source whose initial value is its Euclidean distance to the
-nearest footprint cell; if no traversable cell is that close the reach grows by 1.5x up to
-3 m (a labelled fallback for objects in cluttered corners of the scanned Gibson maps, whose
-navigable channel keeps a gap around furniture). So ``GoalDistance.distance(xy)`` is the
+``VIEW_RADIUS`` (1.0 m, Euclidean) of the object's footprint that sees the object is a *view
+point* (as Habitat's ObjectNav goal view points, which are kept only where the object is
+visible) and a source whose initial value is its Euclidean distance to the nearest footprint
+cell. *Sees* means a straight line from the cell to one of the footprint cells crosses no
+``House.sight_walls`` cell: without it, a robot shut in the next room counted as having found
+an object on the other side of the wall. If no traversable cell is that close the reach grows
+by 1.5x up to 3 m (a labelled fallback for objects in cluttered corners of the scanned Gibson
+maps, whose navigable channel keeps a gap around furniture). So ``GoalDistance.distance(xy)`` is the
 geodesic distance from the robot centre to the nearest goal footprint. This module computes distances only;
 it must not move the robot or render.
 """
@@ -114,9 +117,44 @@ def house_graph(house: House, radius: float) -> GridGraph:
     return graph
 
 
-def goal_sources(graph: GridGraph, footprint: np.ndarray, resolution: float, radius: float
-                 ) -> tuple[np.ndarray, np.ndarray]:
-    """Traversable source cells near a footprint ((N, 2) cells) and their offsets (m)."""
+SIGHT_TARGETS = 24  # footprint cells a view point may look at (a spread sample of big footprints)
+
+
+def sees_footprint(cells: np.ndarray, footprint: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    """(N,) bool: whether a straight line from each of ``cells`` (N, 2) to some cell of
+    ``footprint`` (M, 2) crosses no ``walls`` cell.
+
+    Lines are sampled every quarter cell. The walls are first closed diagonally (each wall cell
+    also blocks its lower-right neighbours), so a line cannot slip between two wall cells that
+    touch only at a corner; footprint cells never block their own object.
+    """
+    blocked = walls.copy()
+    blocked[1:, :] |= walls[:-1, :]
+    blocked[:, 1:] |= walls[:, :-1]
+    blocked[1:, 1:] |= walls[:-1, :-1]
+    blocked[footprint[:, 0], footprint[:, 1]] = False
+    targets = footprint
+    if len(targets) > SIGHT_TARGETS:
+        targets = targets[np.linspace(0, len(targets) - 1, SIGHT_TARGETS).round().astype(np.int64)]
+    src = cells.astype(np.float64)
+    seen = np.zeros(len(cells), dtype=bool)
+    for t in targets.astype(np.float64):
+        todo = np.flatnonzero(~seen)
+        if not len(todo):
+            break
+        delta = t - src[todo]
+        n = int(np.ceil(4.0 * np.abs(delta).max())) + 1
+        frac = np.linspace(0.0, 1.0, n)[1:-1]  # strictly between the two cell centres
+        rr = np.rint(src[todo, 0, None] + delta[:, 0, None] * frac).astype(np.int64)
+        cc = np.rint(src[todo, 1, None] + delta[:, 1, None] * frac).astype(np.int64)
+        seen[todo] = ~blocked[rr, cc].any(axis=1) if len(frac) else True
+    return seen
+
+
+def goal_sources(graph: GridGraph, footprint: np.ndarray, resolution: float, radius: float,
+                 walls: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Traversable source cells near a footprint ((N, 2) cells) and their offsets (m); with
+    ``walls`` ((H, W) bool), only cells that see the footprint past them."""
     h, w = graph.mask.shape
     foot = np.zeros((h, w), dtype=bool)
     if len(footprint):
@@ -129,7 +167,12 @@ def goal_sources(graph: GridGraph, footprint: np.ndarray, resolution: float, rad
         sel = graph.mask & (dist <= reach)
         if sel.any():
             rr, cc = np.nonzero(sel)
-            return np.stack([rr, cc], axis=1), dist[rr, cc]
+            cells = np.stack([rr, cc], axis=1)
+            if walls is not None:
+                keep = sees_footprint(cells, np.argwhere(foot), walls)
+                cells = cells[keep]
+            if len(cells):
+                return cells, dist[cells[:, 0], cells[:, 1]]
         reach *= 1.5
     return np.zeros((0, 2), dtype=np.int64), np.zeros(0)
 
@@ -160,7 +203,8 @@ class GoalDistance:
         if cached is None:
             graph = house_graph(house, self.radius)
             foot = np.concatenate([house.footprint(i) for i in ids])
-            cells, offsets = goal_sources(graph, foot, house.nav.resolution, self.radius)
+            cells, offsets = goal_sources(graph, foot, house.nav.resolution, self.radius,
+                                          house.sight_walls)
             cached = graph.multi_source(cells, offsets)
             cached.flags.writeable = False
             house._cache[key] = cached

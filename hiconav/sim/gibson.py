@@ -219,4 +219,4 @@ def load_gibson(scene: str, floor: int, data_dir: Path) -> House:
                  quads=QuadSet.concat(quads),
                  footprints=footprints, wall_height=WALL_HEIGHT,
                  floor_color=(0.5, 0.47, 0.42), source=info_path(data_dir),
-                 floor_height=floor_height)
+                 floor_height=floor_height, sight_walls=walls)

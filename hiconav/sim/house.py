@@ -182,7 +182,9 @@ class House:
     rooms: room polygons (may be empty for scanned houses); boxes: render geometry of walls,
     clutter and objects (objects keep their instance id); footprints: instance id -> (N, 2)
     int grid cells (row, col) covered by the object's footprint (goal cells for ObjectNav);
-    wall_height: ceiling height (m).
+    wall_height: ceiling height (m); sight_walls: (H, W) bool cells of the walls that stand at
+    the camera's height (``SIGHT_HEIGHT``): a goal view point must see its object past them
+    (None: nothing blocks the view).
     """
 
     name: str
@@ -198,6 +200,7 @@ class House:
     source: str = ""
     start_hint: tuple[float, float, float] | None = None  # (x, y, yaw) from the data set
     floor_height: float = 0.0  # source-frame height of this floor (Gibson episodes)
+    sight_walls: np.ndarray | None = None
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
@@ -413,6 +416,7 @@ def runs_to_boxes(mask: np.ndarray, origin: np.ndarray, res: float, z0: float, z
 
 
 BLOCK_BELOW = 1.2  # m: geometry whose bottom is below this blocks the robot's disc
+SIGHT_HEIGHT = 0.88  # m: camera height of the ObjectNav robot; walls spanning it block the view
 
 
 def assemble_house(name: str, rooms: list[Room], walls: list[Wall], objects: list[SimObject],
@@ -454,10 +458,17 @@ def assemble_house(name: str, rooms: list[Room], walls: list[Wall], objects: lis
                                   np.array(b.size), b.yaw)
             if m.size:
                 blocked[rs, cs] |= m
+    sight = np.zeros(shape, dtype=bool)
+    for b in boxes:
+        if b.material == "wall" and abs(b.center[2] - SIGHT_HEIGHT) <= b.size[2] / 2.0:
+            rs, cs, m = rect_mask(shape, origin, resolution, np.array(b.center),
+                                  np.array(b.size), b.yaw)
+            if m.size:
+                sight[rs, cs] |= m
     nav = NavGrid(floor & ~blocked, origin.astype(np.float64), resolution)
     wall_height = max((w.height for w in walls), default=2.6)
     return House(name=name, objects=list(objects), nav=nav, rooms=list(rooms), boxes=boxes,
-                 wall_height=float(wall_height), source=source)
+                 wall_height=float(wall_height), source=source, sight_walls=sight)
 
 
 @dataclass(frozen=True)

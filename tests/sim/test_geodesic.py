@@ -95,3 +95,30 @@ def test_unreachable_goal_is_infinite():
     gd = GoalDistance(house, instance_ids=[0])
     assert math.isinf(gd.distance(np.array([2.0, 2.0])))
     assert math.isfinite(gd.distance(np.array([6.0, 5.0])))
+
+
+def test_a_goal_behind_a_wall_is_not_found_from_the_other_side():
+    """View points must see the object: a painting 0.3 m behind a wall is 0.45 m away in a
+    straight line from the next room, but that room's robot must walk round through the gap."""
+    wall = Wall((4.0, 0.0), (4.0, 6.0), 2.5, 0.1)  # open only for y in (6, 8)
+    house = box_room(8.0, [obj(0, "painting", (4.35, 2.0, 1.5), (0.1, 0.6, 0.5))], [wall])
+    assert house.sight_walls is not None and house.sight_walls.any()
+    gd = GoalDistance(house, instance_ids=[0])
+    beside = gd.distance(np.array([3.6, 2.0]))  # next room, 0.7 m from the painting's cells
+    assert beside > 5.0  # round through the gap at y = 6 and back down
+    assert gd.distance(np.array([4.8, 2.0])) < 0.6  # in front of it
+    # Without sight walls (the old rule) the next room counted as a view point.
+    import dataclasses
+
+    blind = GoalDistance(dataclasses.replace(house, sight_walls=None, _cache={}), instance_ids=[0])
+    assert blind.distance(np.array([3.6, 2.0])) < 1.0
+
+
+def test_a_line_cannot_slip_between_wall_cells_that_touch_at_a_corner():
+    from hiconav.sim.geodesic import sees_footprint
+
+    walls = np.zeros((9, 9), dtype=bool)
+    for k in range(9):
+        walls[k, 8 - k] = True  # a one-cell staircase wall from (0, 8) to (8, 0)
+    seen = sees_footprint(np.array([[1, 1], [8, 8]]), np.array([[7, 7]]), walls)
+    assert seen.tolist() == [False, True]
