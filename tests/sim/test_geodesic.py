@@ -120,5 +120,5 @@ def test_a_line_cannot_slip_between_wall_cells_that_touch_at_a_corner():
     walls = np.zeros((9, 9), dtype=bool)
     for k in range(9):
         walls[k, 8 - k] = True  # a one-cell staircase wall from (0, 8) to (8, 0)
-    seen = sees_footprint(np.array([[1, 1], [8, 8]]), np.array([[7, 7]]), walls)
+    seen = sees_footprint(np.array([[1, 1], [8, 8]]), np.array([[7, 7]]), walls, 10.0)
     assert seen.tolist() == [False, True]
