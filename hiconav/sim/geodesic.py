@@ -126,19 +126,21 @@ def sees_footprint(cells: np.ndarray, footprint: np.ndarray, walls: np.ndarray,
     ``footprint`` (M, 2) no farther than ``reach_cells`` crosses no ``walls`` cell.
 
     Only the footprint's boundary cells are looked at (a line to an inner cell crosses the
-    boundary first), one per ``SIGHT_BLOCK`` block. Lines are sampled every quarter cell. The
-    walls are first closed diagonally (each wall cell also blocks its lower-right neighbours),
-    so a line cannot slip between two wall cells that touch only at a corner; footprint cells
-    never block their own object.
+    boundary first), one per ``SIGHT_BLOCK`` block. Lines are sampled every quarter cell. Corner
+    gaps are closed first (a free cell with wall cells on two orthogonal sides blocks), so a
+    line cannot slip between two wall cells that touch only at a corner; footprint cells never
+    block their own object (a painting's cell may lie in its wall).
     """
     h, w = walls.shape
-    blocked = walls.copy()
-    blocked[1:, :] |= walls[:-1, :]
-    blocked[:, 1:] |= walls[:, :-1]
-    blocked[1:, 1:] |= walls[:-1, :-1]
     foot = np.zeros((h, w), dtype=bool)
     foot[footprint[:, 0], footprint[:, 1]] = True
-    blocked &= ~foot
+    walls = walls & ~foot
+    # close the corner gaps of staircase walls: a cell with wall cells on two orthogonal sides
+    # blocks too (straight walls do not grow: the cell next to a wall has a wall on one side)
+    pad = np.pad(walls, 1)
+    up, down = pad[:-2, 1:-1], pad[2:, 1:-1]
+    left, right = pad[1:-1, :-2], pad[1:-1, 2:]
+    blocked = walls | ((up | down) & (left | right) & ~foot)
     edge = foot & ~ndimage.binary_erosion(foot)
     targets = np.argwhere(edge)
     _, first = np.unique(targets // SIGHT_BLOCK, axis=0, return_index=True)

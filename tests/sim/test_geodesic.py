@@ -122,3 +122,15 @@ def test_a_line_cannot_slip_between_wall_cells_that_touch_at_a_corner():
         walls[k, 8 - k] = True  # a one-cell staircase wall from (0, 8) to (8, 0)
     seen = sees_footprint(np.array([[1, 1], [8, 8]]), np.array([[7, 7]]), walls, 10.0)
     assert seen.tolist() == [False, True]
+
+
+def test_an_object_whose_cell_lies_in_its_wall_is_seen_from_its_own_side_only():
+    """A painting's single footprint cell can fall in the wall row it hangs on; the wall must
+    not grow over the free cells in front of it."""
+    from hiconav.sim.geodesic import sees_footprint
+
+    walls = np.zeros((12, 12), dtype=bool)
+    walls[5:7, :] = True  # a two-cell wall, rows 5 and 6
+    foot = np.array([[6, 6]])  # the painting, in the wall's upper row
+    seen = sees_footprint(np.array([[7, 6], [9, 6], [10, 8], [3, 6]]), foot, walls, 10.0)
+    assert seen.tolist() == [True, True, True, False]
