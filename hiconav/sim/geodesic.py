@@ -13,7 +13,9 @@ cell. *Sees* means a straight line from the cell to one of the footprint cells c
 ``House.sight_walls`` cell: without it, a robot shut in the next room counted as having found
 an object on the other side of the wall. If no traversable cell is that close the reach grows
 by 1.5x up to 3 m (a labelled fallback for objects in cluttered corners of the scanned Gibson
-maps, whose navigable channel keeps a gap around furniture). So ``GoalDistance.distance(xy)`` is the
+maps, whose navigable channel keeps a gap around furniture); the offsets of such far view
+points are scaled by ``VIEW_RADIUS / reach``, so that the nearest of them lie within the
+success distance (unscaled, an episode on such an object could never succeed). So ``GoalDistance.distance(xy)`` is the
 geodesic distance from the robot centre to the nearest goal footprint. This module computes distances only;
 it must not move the robot or render.
 """
@@ -182,7 +184,10 @@ def goal_sources(graph: GridGraph, footprint: np.ndarray, resolution: float, rad
                 keep = sees_footprint(cells, np.argwhere(foot), walls, reach / resolution)
                 cells = cells[keep]
             if len(cells):
-                return cells, dist[cells[:, 0], cells[:, 1]]
+                offsets = dist[cells[:, 0], cells[:, 1]]
+                if reach > VIEW_RADIUS:  # the labelled fallback: far view points, scaled
+                    offsets = offsets * (VIEW_RADIUS / reach)
+                return cells, offsets
         reach *= 1.5
     return np.zeros((0, 2), dtype=np.int64), np.zeros(0)
 

@@ -134,3 +134,17 @@ def test_an_object_whose_cell_lies_in_its_wall_is_seen_from_its_own_side_only():
     foot = np.array([[6, 6]])  # the painting, in the wall's upper row
     seen = sees_footprint(np.array([[7, 6], [9, 6], [10, 8], [3, 6]]), foot, walls, 10.0)
     assert seen.tolist() == [True, True, True, False]
+
+
+def test_an_object_that_no_view_point_reaches_within_a_metre_can_still_be_found():
+    """The fallback ring (Gibson's gap around furniture): the nearest traversable cells are
+    1.25 m from the footprint, and stopping there must count."""
+    from hiconav.sim.geodesic import VIEW_RADIUS, goal_sources, house_graph
+
+    house = box_room(8.0, [obj(0, "toilet", (4.0, 4.0, 0.4), (0.5, 0.5, 0.8)),
+                           obj(1, "cabinet", (4.0, 4.0, 0.4), (2.5, 2.5, 0.8))])
+    graph = house_graph(house, 0.18)
+    cells, offsets = goal_sources(graph, house.footprint(0), house.nav.resolution, 0.18)
+    assert len(cells) and offsets.min() <= VIEW_RADIUS
+    gd = GoalDistance(house, instance_ids=[0])
+    assert gd.distance(np.array([4.0, 5.5])) <= 1.0  # beside the cabinet, 1.25 m from the toilet

@@ -340,7 +340,11 @@ def test_explore_skips_a_frontier_its_visit_did_not_clear_even_under_a_new_id(tm
     ctx.plan = _plan_at(4.0, (7, (8.1, 8.0)), (8, (1.0, 8.0)))
     tree.tick()
     assert ctx.spent_viewpoints == []
-    # the first plan after the visit still has a frontier there (renumbered): the spot is spent
+    # a plan made just after the visit does not decide either: the robot may still be turning
+    ctx.plan = _plan_at(5.2, (7, (8.1, 8.0)), (8, (1.0, 8.0)))
+    tree.tick()
+    assert ctx.spent_viewpoints == []
+    # a plan made spent_after_s after the visit still has a frontier there (renumbered): spent
     clock.t = 6.0
     ctx.plan = _plan_at(5.5, (9, (8.1, 8.0)), (10, (1.0, 8.0)))
     tree.tick()
@@ -365,7 +369,30 @@ def test_explore_does_not_spend_a_viewpoint_whose_frontier_cleared(tmp_path):
     ctx.nav = NavStatus(first.seq, "reached", 0.0)
     tree.tick()
     clock.t = 6.0
-    ctx.plan = _plan_at(5.5, (3, (9.5, 8.0)), (4, (1.0, 8.0)))  # the frontier moved on, 1.5 m
+    ctx.plan = _plan_at(5.6, (3, (9.5, 8.0)), (4, (1.0, 8.0)))  # the frontier moved on, 1.5 m
     tree.tick()
     assert ctx.spent_viewpoints == []
     assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.ref_id == 3
+
+
+def test_explore_goes_to_a_frontier_viewpoint_facing_the_frontier(tmp_path):
+    from dataclasses import replace
+
+    import numpy as np
+    from hiconav.mapping.frontiers import Frontier
+
+    clock = Clock()
+    ctx = _ctx(clock)
+    far = Frontier(0, np.array([8.0, 9.0]), np.array([8.0, 8.0]), 10)  # centroid 1 m north of the viewpoint
+    near = Frontier(1, np.array([1.0, 8.05]), np.array([1.0, 8.0]), 10)
+    base = plan((0.0, 0.0))
+    ctx.plan = replace(base, plan=type(base.plan)(far, (0, 1)), frontiers=(far, near))
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {}\n"), ctx)
+    tree.tick()
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert goal.ref_id == 0 and goal.yaw == pytest.approx(math.pi / 2)
+    # a viewpoint on top of its centroid has no facing
+    ctx.plan = replace(base, plan=type(base.plan)(near, (1,)), frontiers=(near,))
+    tree.tick()
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert goal.ref_id == 1 and goal.yaw is None

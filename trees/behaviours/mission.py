@@ -136,12 +136,14 @@ class Explore(MissionBehaviour):
     context's (``last_frontier_time``), so an Explore retried after the map was explored out fails
     at once instead of idling (and turning) again for every retry.
 
-    A frontier can outlive a visit: from its viewpoint the camera may not see it (the floor
-    close to the robot is below the field of view, a wall nearer than the minimum depth reads
-    nothing). When the first plan made after reaching a viewpoint still has a frontier viewpoint
-    within ``spent_radius`` of it, that spot is spent (``context.spent_viewpoints``): frontiers
-    seen from there are skipped for the rest of the mission, instead of being reached, looked
-    at and chosen again, under a new frontier id, for hundreds of steps."""
+    The robot goes to a frontier's viewpoint facing the frontier's centroid, so that on arrival
+    the camera looks at it. A frontier can still outlive the visit: from its viewpoint the
+    camera may not see it (the floor close to the robot is below the field of view, a wall
+    nearer than the minimum depth reads nothing). When a plan made ``spent_after_s`` or more
+    after reaching a viewpoint still has a frontier viewpoint within ``spent_radius`` of it,
+    that spot is spent (``context.spent_viewpoints``): frontiers seen from there are skipped for
+    the rest of the mission, instead of being reached, looked at and chosen again, under a new
+    frontier id, for hundreds of steps."""
 
     PARAMS = {
         "max_idle_s": Param(float, 15.0, minimum=0.0, maximum=3600.0, doc="no frontier for this long: fail"),
@@ -150,6 +152,8 @@ class Explore(MissionBehaviour):
         "look_turns": Param(int, 4, minimum=0, maximum=100, doc="quarter turns in place when no frontier is known"),
         "spent_radius": Param(float, 0.4, minimum=0.0, maximum=5.0,
                               doc="a frontier viewpoint this near a reached one that did not clear it is skipped"),
+        "spent_after_s": Param(float, 0.5, minimum=0.0, maximum=60.0,
+                               doc="judge a reached viewpoint on plans made this long after the visit"),
     }
 
     def initialise(self) -> None:
@@ -176,7 +180,7 @@ class Explore(MissionBehaviour):
         views = np.array([f.viewpoint for f in msg.frontiers], dtype=np.float64).reshape(-1, 2)
         waiting = []
         for xy, t in self._reached:
-            if msg.stamp <= t:
+            if msg.stamp < t + self.param("spent_after_s"):
                 waiting.append((xy, t))
             elif len(views) and float(np.min(np.hypot(*(views - xy).T))) <= r:
                 self.context.spent_viewpoints.append((float(xy[0]), float(xy[1])))
@@ -184,7 +188,9 @@ class Explore(MissionBehaviour):
                                            f"({xy[0]:.2f}, {xy[1]:.2f}) spent: reached, not cleared")
         self._reached = waiting
 
-    def _pick(self) -> tuple[int, np.ndarray] | None:
+    def _pick(self) -> tuple[int, np.ndarray, float | None] | None:
+        """(frontier id, viewpoint xy, yaw facing the frontier's centroid or None) of the first
+        frontier of the plan's order that is neither visited nor seen from a spent spot."""
         msg = self.context.plan
         if msg is None:
             return None
@@ -197,7 +203,9 @@ class Explore(MissionBehaviour):
             if fid in frontiers and fid not in self._visited:
                 xy = np.asarray(frontiers[fid].viewpoint, dtype=np.float64)
                 if not self._spent(xy):
-                    return fid, xy
+                    d = np.asarray(frontiers[fid].centroid, dtype=np.float64) - xy
+                    yaw = math.atan2(d[1], d[0]) if float(np.hypot(*d)) > 0.2 else None
+                    return fid, xy, yaw
         return None
 
     def update(self) -> Status:
@@ -230,10 +238,10 @@ class Explore(MissionBehaviour):
             return Status.RUNNING
         ctx.last_frontier_time = now
         self._looks = 0
-        fid, xy = pick
+        fid, xy, yaw = pick
         moved = self._goal_xy is None or float(np.hypot(*(xy - self._goal_xy))) > self.param("switch_distance")
         if self._seq is None or fid != self._frontier or moved:
-            self._seq = ctx.send_goal(Goal(float(xy[0]), float(xy[1]), None, self.param("goal_tolerance"),
+            self._seq = ctx.send_goal(Goal(float(xy[0]), float(xy[1]), yaw, self.param("goal_tolerance"),
                                            "frontier", int(fid)))
             self._frontier, self._goal_xy = fid, xy
         self.feedback_message = f"frontier #{fid}"
