@@ -161,3 +161,17 @@ def test_build_detector_from_config():
         build_detector(PerceptionConfig(detector="owlvit"))
     with pytest.raises(ConfigError, match="perception.detector"):
         build_detector(PerceptionConfig(detector="yolo"))
+
+
+def test_counter_draws_are_uniform_and_keyed_by_seed_seq_and_key():
+    from hiconav.perception.oracle import CounterDraws
+
+    a = CounterDraws(7, 3, 11).random(4)
+    assert a == CounterDraws(7, 3, 11).random(4)
+    assert a != CounterDraws(7, 3, 12).random(4) and a != CounterDraws(7, 4, 11).random(4)
+    assert a != CounterDraws(8, 3, 11).random(4)
+    u = np.array([CounterDraws(0, seq, key).random() for seq in range(200) for key in range(50)])
+    assert 0.0 <= u.min() and u.max() < 1.0
+    assert abs(u.mean() - 0.5) < 0.01 and abs(np.mean(u < 0.1) - 0.1) < 0.01
+    k = np.array([CounterDraws(1, seq, 0).integers(3, 7) for seq in range(4000)])
+    assert set(k.tolist()) == {3, 4, 5, 6} and abs(np.mean(k == 6) - 0.25) < 0.03
