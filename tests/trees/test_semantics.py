@@ -396,22 +396,3 @@ def test_explore_goes_to_a_frontier_viewpoint_facing_the_frontier(tmp_path):
     tree.tick()
     goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
     assert goal.ref_id == 1 and goal.yaw is None
-
-
-def test_approach_cell_is_never_behind_the_wall_the_target_hangs_on():
-    """A tv on the south face of a wall at y = 5: the robot comes from the north side of the wall
-    (a door far to the east joins the two sides), where cells are just as near the tv's box but
-    cannot see it; the approach cell must be on the tv's own side."""
-    import numpy as np
-    from hiconav.trees.behaviours.mission import approach_cell
-
-    from .fakes import FakeGrid
-
-    state = np.zeros((100, 100), dtype=np.int8)
-    state[0, :] = state[-1, :] = state[:, 0] = state[:, -1] = 1
-    state[50, :85] = 1  # the wall at y = 5.0 m, open for x > 8.5 m
-    grid = FakeGrid(state, np.zeros_like(state, dtype=bool))
-    tv_min, tv_max = np.array([4.0, 4.85, 1.0]), np.array([5.0, 4.95, 1.6])  # on the wall's south face
-    robot = np.array([4.5, 7.0])  # north of the wall
-    cell = approach_cell(grid, tv_min, tv_max, robot, 0.8)
-    assert cell is not None and cell[1] < 5.0, cell  # south of the wall

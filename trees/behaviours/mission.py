@@ -23,35 +23,10 @@ from hiconav.mapping.occupancy import lethal_mask
 from hiconav.types import Goal, wrap_angle
 
 
-def _sees_box(state: np.ndarray, rows: np.ndarray, cols: np.ndarray, box_min: np.ndarray,
-              box_max: np.ndarray, origin: tuple[float, float], res: float) -> np.ndarray:
-    """(N,) bool: whether the straight line from each cell (rows, cols) to the nearest point of
-    the box's footprint crosses no occupied cell of ``state``. Points within one cell of the box
-    are not checked: the object's own cells (marked up to half a cell past its surface) end it."""
-    ox, oy = origin
-    x = ox + (cols + 0.5) * res
-    y = oy + (rows + 0.5) * res
-    tx = np.clip(x, box_min[0], box_max[0])
-    ty = np.clip(y, box_min[1], box_max[1])
-    length = np.hypot(tx - x, ty - y)
-    n = max(int(np.ceil(2.0 * float(length.max(initial=0.0)) / res)), 1)
-    frac = np.linspace(0.0, 1.0, n + 1)[1:]  # (S,)
-    sx = x[:, None] + (tx - x)[:, None] * frac[None, :]  # (N, S)
-    sy = y[:, None] + (ty - y)[:, None] * frac[None, :]
-    keep = ~((sx >= box_min[0] - res) & (sx <= box_max[0] + res)
-             & (sy >= box_min[1] - res) & (sy <= box_max[1] + res))
-    h, w = state.shape
-    sr = np.clip(((sy - oy) / res).astype(np.int64), 0, h - 1)
-    sc = np.clip(((sx - ox) / res).astype(np.int64), 0, w - 1)
-    return ~np.any((state[sr, sc] == 1) & keep, axis=1)
-
-
 def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy: np.ndarray,
                   max_distance: float, exclude: list[np.ndarray] | None = None,
                   tight: bool = False) -> np.ndarray | None:
-    """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint,
-    from which the footprint is in sight (no occupied cell on the straight line to it: a cell
-    behind the wall that a tv hangs on is near the tv, but the robot there cannot see it).
+    """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint.
 
     grid: snapshot with ``state`` (H, W) int8 (0 free), ``inflated`` (H, W) bool, ``origin`` (2,),
     ``resolution``; box_min / box_max: (3,) world metres (only x, y used); robot_xy: (2,) world.
@@ -90,11 +65,6 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
         ok &= labels[r0:r1, c0:c1] == robot_label
     for ex in exclude or []:
         ok &= np.hypot(x - ex[0], y - ex[1]) > 0.3
-    if np.any(ok):
-        rr, cc = np.nonzero(ok)
-        seen = _sees_box(state, rr + r0, cc + c0, np.asarray(box_min, dtype=np.float64),
-                         np.asarray(box_max, dtype=np.float64), (ox, oy), res)
-        ok[rr[~seen], cc[~seen]] = False
     if not np.any(ok):
         return None
     if tight and np.any(ok & roomy[r0:r1, c0:c1]):
