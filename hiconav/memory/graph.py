@@ -136,7 +136,8 @@ class CognitiveMemoryGraph:
     def _node_arrays(self, exclude: int | None = None
                      ) -> tuple[list[int], np.ndarray, np.ndarray, np.ndarray, list]:
         """(ids, mins (K, 3), maxs (K, 3), features (K, D), embeddings) of all nodes but
-        ``exclude``; the stacked arrays are cached until a node changes (``_dirty``)."""
+        ``exclude``; the stacked arrays are cached until a node is added, merged or removed
+        (``_dirty``); a node that absorbs an observation updates its own row (``_refresh``)."""
         if self._arrays is None:
             ids = list(self.objects)
             nodes = [self.objects[i] for i in ids]
@@ -155,6 +156,24 @@ class CognitiveMemoryGraph:
 
     def _dirty(self) -> None:
         self._arrays = None
+
+    def _refresh(self, node_id: int) -> None:
+        """Node ``node_id`` changed in place (absorbed an observation): update its row of the
+        stacked arrays instead of restacking every node on the next match (every frame absorbs)."""
+        if self._arrays is None:
+            return
+        ids, mins, maxs, feats, embs = self._arrays
+        try:
+            i = ids.index(node_id)
+        except ValueError:
+            self._arrays = None
+            return
+        node = self.objects[node_id]
+        if feats.shape[1:] != np.shape(node.feature):
+            self._arrays = None
+            return
+        mins[i], maxs[i], feats[i] = node.box_min, node.box_max, node.feature
+        embs[i] = node.embedding
 
     def _best_match(self, obs: ObjectObservation) -> tuple[int | None, float]:
         ids, mins, maxs, feats, embs = self._node_arrays()
@@ -220,7 +239,7 @@ class CognitiveMemoryGraph:
                     j = node.id
                 else:
                     self.objects[j].absorb(obs, self.stamp, cfg)
-                    self._dirty()
+                    self._refresh(j)
                     updated.append(j)
                 node = self.objects[j]
                 node.anchor_ids.add(anchor.id)  # bipartite edge (a_i, o_j)
@@ -235,7 +254,7 @@ class CognitiveMemoryGraph:
             for obs, j in zip(observations, matches):
                 if j is not None:
                     self.objects[j].absorb(obs, self.stamp, cfg)
-                    self._dirty()
+                    self._refresh(j)
                     updated.append(j)
             if updated:
                 if cfg.merge_nodes:

@@ -239,3 +239,18 @@ def test_snapshot_is_stable_and_shares_unchanged_views(embedder):
     assert np.array_equal(old.box_min, old_min) and old.n_obs == 1
     with pytest.raises(KeyError, match="object 42"):
         s3.object(42)
+
+
+def test_cached_node_arrays_follow_absorbed_observations(embedder):
+    """Absorbing updates the node's row of the cached match arrays in place; they must equal a
+    fresh stack of every node after each frame (a stale row would mis-match later detections)."""
+    g = graph(embedder, update_objects_every_frame=True)
+    boxes = [chair(3.0, 0.0), chair(3.0, 1.5)]
+    for k, (x, y) in enumerate([(0.0, 0.0), (0.3, 0.1), (0.6, -0.1), (1.0, 0.2), (2.0, -1.6)]):
+        observe(g, look_at(x, y, 3.0, 0.5), boxes, float(k))
+        ids, mins, maxs, feats, _ = g._node_arrays()
+        assert ids == list(g.objects)
+        np.testing.assert_array_equal(mins, np.stack([g.objects[i].box_min for i in ids]))
+        np.testing.assert_array_equal(maxs, np.stack([g.objects[i].box_max for i in ids]))
+        np.testing.assert_array_equal(feats, np.stack([g.objects[i].feature for i in ids]))
+    assert any(g.objects[i].n_obs > 1 for i in g.objects)
