@@ -326,7 +326,8 @@ def _plan_at(stamp: float, *frontiers: tuple[int, tuple[float, float]]):
                    stamp=stamp)
 
 
-def test_explore_skips_a_frontier_its_visit_did_not_clear_even_under_a_new_id(tmp_path):
+def _reach_first_frontier(tmp_path):
+    """Explore over frontiers 0 at (8, 8) and 1 at (1, 8); the robot reaches 0 at t = 5 s."""
     clock = Clock()
     ctx = _ctx(clock)
     ctx.plan = _plan_at(0.0, (0, (8.0, 8.0)), (1, (1.0, 8.0)))
@@ -336,6 +337,11 @@ def test_explore_skips_a_frontier_its_visit_did_not_clear_even_under_a_new_id(tm
     assert first.goal.ref_id == 0
     clock.t = 5.0
     ctx.nav = NavStatus(first.seq, "reached", 0.0)
+    return clock, ctx, tree
+
+
+def test_explore_skips_a_frontier_its_visit_did_not_clear_even_under_a_new_id(tmp_path):
+    clock, ctx, tree = _reach_first_frontier(tmp_path)
     # a plan older than the visit does not decide: the frontier may still clear
     ctx.plan = _plan_at(4.0, (7, (8.1, 8.0)), (8, (1.0, 8.0)))
     tree.tick()
@@ -359,14 +365,7 @@ def test_explore_skips_a_frontier_its_visit_did_not_clear_even_under_a_new_id(tm
 
 
 def test_explore_does_not_spend_a_viewpoint_whose_frontier_cleared(tmp_path):
-    clock = Clock()
-    ctx = _ctx(clock)
-    ctx.plan = _plan_at(0.0, (0, (8.0, 8.0)), (1, (1.0, 8.0)))
-    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {}\n"), ctx)
-    tree.tick()
-    first = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
-    clock.t = 5.0
-    ctx.nav = NavStatus(first.seq, "reached", 0.0)
+    clock, ctx, tree = _reach_first_frontier(tmp_path)
     tree.tick()
     clock.t = 6.0
     ctx.plan = _plan_at(5.6, (3, (9.5, 8.0)), (4, (1.0, 8.0)))  # the frontier moved on, 1.5 m
