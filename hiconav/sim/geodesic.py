@@ -15,9 +15,9 @@ an object on the other side of the wall. If no traversable cell is that close th
 by 1.5x up to 3 m (a labelled fallback for objects in cluttered corners of the scanned Gibson
 maps, whose navigable channel keeps a gap around furniture); the offsets of such far view
 points are scaled by ``VIEW_RADIUS / reach``, so that the nearest of them lie within the
-success distance (unscaled, an episode on such an object could never succeed). So ``GoalDistance.distance(xy)`` is the
-geodesic distance from the robot centre to the nearest goal footprint. This module computes distances only;
-it must not move the robot or render.
+success distance (unscaled, an episode on such an object could never succeed). So
+``GoalDistance.distance(xy)`` is the geodesic distance from the robot centre to the nearest goal
+footprint. This module computes distances only; it must not move the robot or render.
 """
 
 from __future__ import annotations
@@ -122,10 +122,10 @@ def house_graph(house: House, radius: float) -> GridGraph:
 SIGHT_BLOCK = 2  # cells: a view point looks at one footprint boundary cell per 2 x 2 block
 
 
-def sees_footprint(cells: np.ndarray, footprint: np.ndarray, walls: np.ndarray,
+def sees_footprint(cells: np.ndarray, foot: np.ndarray, walls: np.ndarray,
                    reach_cells: float) -> np.ndarray:
-    """(N,) bool: whether a straight line from each of ``cells`` (N, 2) to some cell of
-    ``footprint`` (M, 2) no farther than ``reach_cells`` crosses no ``walls`` cell.
+    """(N,) bool: whether a straight line from each of ``cells`` (N, 2) to some cell of the
+    footprint ``foot`` ((H, W) bool) no farther than ``reach_cells`` crosses no ``walls`` cell.
 
     Only the footprint's boundary cells are looked at (a line to an inner cell crosses the
     boundary first), one per ``SIGHT_BLOCK`` block. Lines are sampled every quarter cell. Corner
@@ -133,9 +133,6 @@ def sees_footprint(cells: np.ndarray, footprint: np.ndarray, walls: np.ndarray,
     line cannot slip between two wall cells that touch only at a corner; footprint cells never
     block their own object (a painting's cell may lie in its wall).
     """
-    h, w = walls.shape
-    foot = np.zeros((h, w), dtype=bool)
-    foot[footprint[:, 0], footprint[:, 1]] = True
     walls = walls & ~foot
     # close the corner gaps of staircase walls: a cell with wall cells on two orthogonal sides
     # blocks too (straight walls do not grow: the cell next to a wall has a wall on one side)
@@ -181,7 +178,7 @@ def goal_sources(graph: GridGraph, footprint: np.ndarray, resolution: float, rad
             rr, cc = np.nonzero(sel)
             cells = np.stack([rr, cc], axis=1)
             if walls is not None:
-                keep = sees_footprint(cells, np.argwhere(foot), walls, reach / resolution)
+                keep = sees_footprint(cells, foot, walls, reach / resolution)
                 cells = cells[keep]
             if len(cells):
                 offsets = dist[cells[:, 0], cells[:, 1]]

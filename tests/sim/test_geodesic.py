@@ -120,7 +120,9 @@ def test_a_line_cannot_slip_between_wall_cells_that_touch_at_a_corner():
     walls = np.zeros((9, 9), dtype=bool)
     for k in range(9):
         walls[k, 8 - k] = True  # a one-cell staircase wall from (0, 8) to (8, 0)
-    seen = sees_footprint(np.array([[1, 1], [8, 8]]), np.array([[7, 7]]), walls, 10.0)
+    foot = np.zeros_like(walls)
+    foot[7, 7] = True
+    seen = sees_footprint(np.array([[1, 1], [8, 8]]), foot, walls, 10.0)
     assert seen.tolist() == [False, True]
 
 
@@ -131,7 +133,8 @@ def test_an_object_whose_cell_lies_in_its_wall_is_seen_from_its_own_side_only():
 
     walls = np.zeros((12, 12), dtype=bool)
     walls[5:7, :] = True  # a two-cell wall, rows 5 and 6
-    foot = np.array([[6, 6]])  # the painting, in the wall's upper row
+    foot = np.zeros_like(walls)
+    foot[6, 6] = True  # the painting, in the wall's upper row
     seen = sees_footprint(np.array([[7, 6], [9, 6], [10, 8], [3, 6]]), foot, walls, 10.0)
     assert seen.tolist() == [True, True, True, False]
 
