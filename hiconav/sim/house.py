@@ -452,19 +452,18 @@ def assemble_house(name: str, rooms: list[Room], walls: list[Wall], objects: lis
     for r in rooms:
         floor |= rasterize_polygon(shape, origin, resolution, r.polygon)
     blocked = np.zeros(shape, dtype=bool)
-    for b in boxes:
-        if b.center[2] - b.size[2] / 2.0 < BLOCK_BELOW:
-            rs, cs, m = rect_mask(shape, origin, resolution, np.array(b.center),
-                                  np.array(b.size), b.yaw)
-            if m.size:
-                blocked[rs, cs] |= m
     sight = np.zeros(shape, dtype=bool)
     for b in boxes:
-        if b.material == "wall" and abs(b.center[2] - SIGHT_HEIGHT) <= b.size[2] / 2.0:
+        blocks = b.center[2] - b.size[2] / 2.0 < BLOCK_BELOW
+        hides = b.material == "wall" and abs(b.center[2] - SIGHT_HEIGHT) <= b.size[2] / 2.0
+        if blocks or hides:
             rs, cs, m = rect_mask(shape, origin, resolution, np.array(b.center),
                                   np.array(b.size), b.yaw)
             if m.size:
-                sight[rs, cs] |= m
+                if blocks:
+                    blocked[rs, cs] |= m
+                if hides:
+                    sight[rs, cs] |= m
     nav = NavGrid(floor & ~blocked, origin.astype(np.float64), resolution)
     wall_height = max((w.height for w in walls), default=2.6)
     return House(name=name, objects=list(objects), nav=nav, rooms=list(rooms), boxes=boxes,
