@@ -43,6 +43,22 @@ def obj(oid: int, label: str, x: float, y: float, n_obs: int = 1, conf: float = 
 
 
 @dataclass(frozen=True)
+class FakeAnchor:
+    id: int
+    T_world_cam: np.ndarray
+    object_ids: tuple = ()
+
+
+def anchor(aid: int, pose: Pose2D, object_ids: tuple = ()) -> FakeAnchor:
+    """An anchor whose camera stands at the pose, looking along its yaw (optical axis = camera z)."""
+    T = np.eye(4)
+    T[:2, 2] = [np.cos(pose.yaw), np.sin(pose.yaw)]
+    T[2, 2] = 0.0
+    T[:2, 3] = [pose.x, pose.y]
+    return FakeAnchor(aid, T, tuple(object_ids))
+
+
+@dataclass(frozen=True)
 class FakeMemory:
     objects: tuple = ()
     anchors: tuple = ()
@@ -55,9 +71,10 @@ class FakeMemory:
         raise KeyError(anchor_id)
 
 
-def world(pose: Pose2D, objects=(), seq: int = 0, grid: FakeGrid | None = None, version: int = 0) -> WorldSnapshot:
+def world(pose: Pose2D, objects=(), seq: int = 0, grid: FakeGrid | None = None, version: int = 0,
+          anchors=()) -> WorldSnapshot:
     return WorldSnapshot(seq, 0.0, pose, grid if grid is not None else open_grid(),
-                         FakeMemory(tuple(objects), version=version))
+                         FakeMemory(tuple(objects), tuple(anchors), version=version))
 
 
 @dataclass(frozen=True)

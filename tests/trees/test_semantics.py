@@ -13,7 +13,7 @@ from hiconav.trees.mission_tree import MissionTree
 from hiconav.messages import GoalMsg, NavStatus, ParseRequest, StopRequest
 from hiconav.types import Pose2D, TaskSpec
 
-from .fakes import obj, plan, world
+from .fakes import anchor, obj, plan, world
 
 S = py_trees.common.Status
 
@@ -155,34 +155,36 @@ FACING_BED = Pose2D(4.0, 4.0, math.pi / 4)  # the bed at (5, 5) is straight ahea
 
 
 def _verify_tree(tmp_path, clock: Clock, params: str, pose: Pose2D = FACING_BED):
-    """A context with one bed node (n_obs 1, memory version 1) and TargetConfirmed -> VerifyTarget."""
+    """A context with one bed node (seen by anchor 1) and TargetConfirmed -> VerifyTarget."""
     ctx = _ctx(clock)
-    ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0, n_obs=1)], version=1)
+    ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0)], anchors=[anchor(1, pose, (3,))])
     tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
                                         f"      - VerifyTarget: {{{params}}}\n"), ctx)
     return ctx, tree
 
 
-def _view(ctx, n_obs: int, version: int, pose: Pose2D = FACING_BED) -> None:
-    ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0, n_obs=n_obs)], version=version)
+def _view(ctx, anchor_id: int, observed: bool, pose: Pose2D = FACING_BED, extra: tuple = ()) -> None:
+    """A new memory anchor ``anchor_id`` taken at ``pose``; it observed the bed when ``observed``.
+    ``extra``: other anchors in the snapshot (made between two ticks)."""
+    anchors = [*extra, anchor(anchor_id, pose, (3,) if observed else ())]
+    ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0)], anchors=anchors)
 
 
 def test_verify_confirms_with_fresh_views_when_close(tmp_path):
     ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2")
+    assert tree.tick() == S.RUNNING  # the anchor from before does not count
+    _view(ctx, 2, True)
     assert tree.tick() == S.RUNNING
-    _view(ctx, 2, 2)
-    assert tree.tick() == S.RUNNING
-    _view(ctx, 3, 3)
+    _view(ctx, 3, True)
     assert tree.tick() == S.SUCCESS
 
 
 def test_verify_rejects_a_candidate_rarely_detected_while_in_view(tmp_path):
     """A spurious box that fell on a place once is outvoted by the frames that show nothing there."""
     ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 10")
-    n_obs = 1
-    for version in range(2, 12):
-        n_obs += version in (4, 9)  # two fresh views in ten frames: below the 50% detection rate
-        _view(ctx, n_obs, version)
+    tree.tick()
+    for aid in range(2, 12):
+        _view(ctx, aid, aid in (4, 9))  # two fresh views in ten frames: below the 50% detection rate
         status = tree.tick()
     assert status == S.FAILURE
     assert ctx.rejections and ctx.rejections[-1][0] == 3 and "2 of 10 frames" in ctx.rejections[-1][1]
@@ -192,9 +194,27 @@ def test_verify_rejects_a_candidate_rarely_detected_while_in_view(tmp_path):
 def test_verify_counts_only_frames_with_the_candidate_in_view(tmp_path):
     away = Pose2D(4.0, 4.0, math.pi)  # the bed is behind the robot
     ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 5", away)
-    for version in range(2, 20):
-        _view(ctx, 1, version, away)
+    for aid in range(2, 20):
+        _view(ctx, aid, False, away)
         assert tree.tick() == S.RUNNING  # not in view: neither confirmed nor rejected
+
+
+def test_verify_judges_each_anchor_from_its_own_camera_and_ignores_pruning(tmp_path):
+    """Frames are the memory's anchors, each judged from its own pose: two anchors made between
+    ticks both count, one looking away does not, and a memory version bumped by pruning (no new
+    anchor) is no frame. The version-based count read val/28/0's real fridge as 3 of 8."""
+    ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 3")
+    tree.tick()
+    away = Pose2D(4.0, 4.0, math.pi)
+    # anchor 2 looked away (the robot has turned back by the time the tick looks); 3 saw the bed
+    _view(ctx, 3, True, FACING_BED, extra=(anchor(2, away),))
+    assert tree.tick() == S.RUNNING
+    for version in range(5, 15):  # pruning moves the version: no new anchor, no frame
+        ctx.world = world(FACING_BED, [obj(3, "bed", 5.0, 5.0)], anchors=[anchor(3, FACING_BED, (3,))],
+                          version=version)
+        assert tree.tick() == S.RUNNING
+    _view(ctx, 4, True)
+    assert tree.tick() == S.SUCCESS
 
 
 def test_approach_sends_a_free_cell_within_distance_facing_the_target(tmp_path):
@@ -395,3 +415,94 @@ def test_explore_goes_to_a_frontier_viewpoint_facing_the_frontier(tmp_path):
     tree.tick()
     goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
     assert goal.ref_id == 1 and goal.yaw is None
+
+
+def test_explore_looks_around_the_start_once_per_mission_before_any_frontier(tmp_path):
+    """start_look_turns quarter turns come first; a preempted and retried Explore finishes them
+    (the count is the mission's), then goes to the first frontier; they are never repeated."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan((8.0, 8.0))
+    text = "root:\n  Explore: {start_look_turns: 4}\n"
+    tree = MissionTree(_write(tmp_path, text), ctx)
+    looks = []
+    for turn in range(3):
+        tree.tick()
+        goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+        assert goal.goal.kind == "look"
+        looks.append(goal.goal.yaw)
+        ctx.nav = NavStatus(goal.seq, "reached", 0.0)
+        ctx.world = world(Pose2D(2.0, 2.0, goal.goal.yaw))
+    assert [math.cos(y) for y in looks] == pytest.approx([0.0, -1.0, 0.0], abs=1e-9)
+    assert [math.sin(y) for y in looks] == pytest.approx([1.0, 0.0, -1.0], abs=1e-9)
+    tree.stop()  # preempted (e.g. by a candidate) during the third quarter turn: it is redone
+    tree2 = MissionTree(_write(tmp_path, text), ctx)
+    for yaw in (0.0, math.pi / 2):  # the third again, then the fourth
+        tree2.tick()
+        goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+        assert goal.goal.kind == "look" and goal.goal.yaw == pytest.approx(yaw)
+        ctx.nav = NavStatus(goal.seq, "reached", 0.0)
+        ctx.world = world(Pose2D(2.0, 2.0, goal.goal.yaw))
+    tree2.tick()
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert goal.kind == "frontier" and goal.ref_id == 0
+    assert ctx.start_looks == 4
+    tree3 = MissionTree(_write(tmp_path, text), ctx)  # a later retry goes straight to frontiers
+    tree3.tick()
+    assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.kind == "frontier"
+
+
+def test_approach_cell_prefers_the_front_of_an_objects_middle_over_its_near_end():
+    """A painting 1 m long on a wall at x = 5: the plain nearest cell lies off its lower end (a
+    grazing view, not a ground-truth view point); with the centre weight the cell faces its middle."""
+    import numpy as np
+    from hiconav.trees.behaviours.mission import approach_cell
+
+    from .fakes import open_grid
+
+    grid = open_grid()
+    grid.state[:, 51:] = 1  # the wall the painting hangs on
+    grid.inflated[:, 49:] = True
+    lo, hi = np.array([5.0, 4.0, 1.2]), np.array([5.05, 5.0, 1.8])
+    robot = np.array([3.0, 2.0])
+    plain = approach_cell(grid, lo, hi, robot, 0.8)
+    centred = approach_cell(grid, lo, hi, robot, 0.8, centre_weight=1.0)
+    assert plain[1] < 4.0  # off the end
+    assert abs(centred[1] - 4.5) < 0.45 and centred[0] > 4.1  # in front of the middle, within 0.8 m
+
+
+def test_approach_is_not_done_on_passing_within_the_distance_off_the_target(tmp_path):
+    """Done at the approach cell, not at the first point within the distance of the footprint."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.world = world(Pose2D(1.5, 1.5, 0.0), [obj(3, "bed", 5.0, 5.0)])
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - Approach: {distance: 0.8}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    # a point 0.7 m off the bed's side, facing it, 0.8 m from the cell: not there yet
+    passing = Pose2D(3.8, 4.9, math.atan2(0.1, 1.2))
+    assert math.hypot(passing.x - goal.x, passing.y - goal.y) > 0.3
+    ctx.world = world(passing, [obj(3, "bed", 5.0, 5.0)])
+    assert tree.tick() == S.RUNNING
+    ctx.world = world(Pose2D(goal.x, goal.y, goal.yaw), [obj(3, "bed", 5.0, 5.0)])
+    assert tree.tick() == S.SUCCESS
+
+
+def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(tmp_path):
+    """A node's label is a vote: a real fridge read as 'cabinet' for a while came back as a
+    fridge, but a permanent rejection had already made the robot explore the house out."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0)])
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - VerifyTarget: {defer_s: 30}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "sofa", 5.0, 5.0)])
+    assert tree.tick() == S.FAILURE
+    assert "label is now 'sofa'" in ctx.rejections[-1][1]
+    assert ctx.excluded(3) and 3 not in ctx.rejected  # deferred, not rejected for good
+    clock.t = 31.0
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0)])
+    assert not ctx.excluded(3)
+    assert [c.object_id for c in ctx.candidates()] == [3]

@@ -25,14 +25,19 @@ from hiconav.types import Goal, wrap_angle
 
 def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy: np.ndarray,
                   max_distance: float, exclude: list[np.ndarray] | None = None,
-                  tight: bool = False) -> np.ndarray | None:
+                  tight: bool = False, centre_weight: float = 0.0) -> np.ndarray | None:
     """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint.
 
     grid: snapshot with ``state`` (H, W) int8 (0 free), ``inflated`` (H, W) bool, ``origin`` (2,),
     ``resolution``; box_min / box_max: (3,) world metres (only x, y used); robot_xy: (2,) world.
     ``tight``: the robot may reach the cell through passages only the robot radius clears (see
     ``OccupancyGrid.lethal``), and such cells count when no cell keeps the inflation margin.
-    Returns the (2,) world xy of the chosen cell centre (nearest to the robot), or None.
+    Returns the (2,) world xy of the chosen cell centre, or None: the cell with the least
+    distance to the robot plus ``centre_weight`` times its distance to the footprint's centre.
+    With a weight, the cell lies in front of the object's middle rather than off one of its
+    ends: from a cell near the end of a painting 0.9 m long the robot sees it at a grazing
+    angle past its wall, and on the ground truth such a cell is not a view point of it
+    (ProcTHOR val/42/1 stopped 0.64 m from the painting's end and 1.12 m from success).
     """
     from scipy import ndimage
 
@@ -70,6 +75,9 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     if tight and np.any(ok & roomy[r0:r1, c0:c1]):
         ok &= roomy[r0:r1, c0:c1]
     cost = np.hypot(x - robot_xy[0], y - robot_xy[1])
+    if centre_weight > 0.0:
+        cx, cy = 0.5 * (box_min[0] + box_max[0]), 0.5 * (box_min[1] + box_max[1])
+        cost = cost + centre_weight * np.hypot(x - cx, y - cy)
     cost = np.where(ok, cost, np.inf)
     i = int(np.argmin(cost))
     return np.array([x.flat[i], y.flat[i]])
@@ -77,6 +85,18 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
 
 def _facing(xy: np.ndarray, center: np.ndarray) -> float:
     return math.atan2(center[1] - xy[1], center[0] - xy[0])
+
+
+def _sees_point(anchor: Any, point: np.ndarray, hfov_deg: float) -> bool:
+    """True when ``point``'s (x, y) lies within half the field of view of the anchor camera's
+    optical axis projected on the floor (its T_world_cam: camera-to-world, z forward)."""
+    T = np.asarray(anchor.T_world_cam, dtype=np.float64)
+    axis = T[:2, 2]
+    rel = np.asarray(point, dtype=np.float64)[:2] - T[:2, 3]
+    if float(np.hypot(*axis)) < 1e-9 or float(np.hypot(*rel)) < 1e-9:
+        return False
+    bearing = abs(wrap_angle(math.atan2(rel[1], rel[0]) - math.atan2(axis[1], axis[0])))
+    return math.degrees(bearing) <= 0.5 * hfov_deg
 
 
 @register_behaviour()
@@ -143,7 +163,14 @@ class Explore(MissionBehaviour):
     after reaching a viewpoint still has a frontier viewpoint within ``spent_radius`` of it,
     that spot is spent (``context.spent_viewpoints``): frontiers seen from there are skipped for
     the rest of the mission, instead of being reached, looked at and chosen again, under a new
-    frontier id, for hundreds of steps."""
+    frontier id, for hundreds of steps.
+
+    ``start_look_turns`` quarter turns in place come first, once per mission (the count lives in
+    the context, so a retried Explore goes on where a preempted one stopped): the camera sees 79
+    degrees, so without them the start room is only known in the direction the robot happened to
+    face, and a target beside the start stayed unseen while the plan led away (ProcTHOR val/28/0:
+    a fridge 1.9 m from the start, never in view in 500 steps). Turning costs steps but no path
+    length."""
 
     PARAMS = {
         "max_idle_s": Param(float, 15.0, minimum=0.0, maximum=3600.0, doc="no frontier for this long: fail"),
@@ -154,6 +181,8 @@ class Explore(MissionBehaviour):
                               doc="a frontier viewpoint this near a reached one that did not clear it is skipped"),
         "spent_after_s": Param(float, 0.5, minimum=0.0, maximum=60.0,
                                doc="judge a reached viewpoint on plans made this long after the visit"),
+        "start_look_turns": Param(int, 0, minimum=0, maximum=100,
+                                  doc="quarter turns in place at the mission's start, before any frontier"),
     }
 
     def initialise(self) -> None:
@@ -165,6 +194,19 @@ class Explore(MissionBehaviour):
         self._visited: set[int] = set()
         self._looks = 0
         self._reached: list[tuple[np.ndarray, float]] = []  # viewpoint, clock time: awaiting a newer plan
+        self._start_look = False  # the goal in flight is one of the start's quarter turns
+
+    def _look_around_start(self) -> Status:
+        """One quarter turn in place after another until ``start_look_turns`` are done."""
+        ctx = self.context
+        pose = ctx.pose
+        if self._seq is None and pose is not None:
+            self._frontier, self._goal_xy = None, None
+            self._seq = ctx.send_goal(Goal(pose.x, pose.y, wrap_angle(pose.yaw + math.pi / 2), 0.5, "look"))
+            self._start_look = True
+        ctx.last_frontier_time = ctx.now()  # looking around is progress
+        self.feedback_message = f"looking around the start ({ctx.start_looks}/{self.param('start_look_turns')})"
+        return Status.RUNNING
 
     def _spent(self, xy: np.ndarray) -> bool:
         r = self.param("spent_radius")
@@ -218,6 +260,11 @@ class Explore(MissionBehaviour):
                 if state == "reached" and self._goal_xy is not None:
                     self._reached.append((self._goal_xy, now))
             self._seq = None
+        if state in ("reached", "failed") and self._start_look:
+            ctx.start_looks += 1
+            self._start_look = False
+        if ctx.start_looks < self.param("start_look_turns"):
+            return self._look_around_start()
         self._settle_reached()
         pick = self._pick()
         if pick is None:
@@ -257,6 +304,8 @@ class _GoToObject(MissionBehaviour):
     """Shared machinery: choose a free cell near the candidate's footprint and go there facing it."""
 
     READS = ("target",)
+    # approach_cell's weight on a cell's distance to the footprint's centre (see Approach)
+    CENTRE_WEIGHT = 0.0
 
     def _send(self, cand: Candidate, distance: float) -> bool:
         ctx = self.context
@@ -264,9 +313,11 @@ class _GoToObject(MissionBehaviour):
         if pose is None or ctx.grid is None:
             return False
         robot = np.array([pose.x, pose.y])
-        cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded)
+        cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded,
+                             centre_weight=self.CENTRE_WEIGHT)
         if cell is None:  # furniture around it: a cell only the robot radius clears will do
-            cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, tight=True)
+            cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, tight=True,
+                                 centre_weight=self.CENTRE_WEIGHT)
         if cell is None:
             return False
         self._cell = cell
@@ -283,16 +334,17 @@ class _GoToObject(MissionBehaviour):
 @register_behaviour()
 class VerifyTarget(_GoToObject):
     """Go within ``verify_distance`` of the candidate, facing it, and confirm it with fresh views:
-    while the robot is close and the candidate's centre is inside the camera's field of view, the
-    target-labelled object nodes at the candidate's place must gain ``min_fresh_views`` new
-    observations and be detected in at least ``min_detection_rate`` of those frames (the frames
-    the memory integrated into its graph, i.e. its anchors, counted by its version; the robot
-    glances 35 degrees left and right of the target so that each glance makes one). A real object is detected in most frames that show it; a
+    of the memory anchors (keyframes) made while the robot is close that have the candidate's
+    centre inside their camera's field of view, at least ``min_fresh_views`` and at least
+    ``min_detection_rate`` of them must have observed a target-labelled node at the candidate's
+    place (the robot glances 35 degrees left and right of the target so that each glance makes
+    an anchor). A real object is detected in most frames that show it; a
     spurious box lands at a random place in a random frame, so one that happened to fall on the
     candidate's place is outvoted by the frames that show nothing there. A candidate seen in too
-    few of ``max_view_frames`` frames, or that vanishes from memory or changes label, is rejected
-    for good (a false positive); one that cannot be reached or re-observed in time is deferred
-    for ``defer_s`` (rejected for good after ``max_deferrals``), so exploration resumes.
+    few of ``max_view_frames`` frames, or that vanishes from memory, is rejected for good (a
+    false positive); one whose label changed, or that cannot be reached or re-observed in time,
+    is deferred for ``defer_s`` (rejected for good after ``max_deferrals``), so exploration
+    resumes.
 
     Fresh views count only target-labelled nodes whose box overlaps the candidate's (grown by
     ``support_margin``): counting every same-label node within a radius let spurious boxes cast
@@ -325,11 +377,10 @@ class VerifyTarget(_GoToObject):
         self._seq = None
         self._excluded: list[np.ndarray] = []
         self._cand: Candidate | None = self.read("target")
-        self._support_close: int | None = None
-        self._support_prev = 0
-        self._fresh = 0
-        self._in_view = 0  # integrated frames (memory versions) with the candidate in the field of view
-        self._frame: int | None = None
+        self._close = False  # the robot has come within verify_distance (+0.25 m) of the candidate
+        self._last_anchor: int | None = None  # the newest memory anchor already judged
+        self._fresh = 0  # anchors in view that observed the candidate
+        self._in_view = 0  # anchors (keyframes) with the candidate in the field of view
         self._glance = 0
         if self._cand is not None and self.context.verify:
             self._send(self._cand, self._goal_distance())
@@ -337,39 +388,47 @@ class VerifyTarget(_GoToObject):
     def _goal_distance(self) -> float:
         return max(self.param("verify_distance") - 0.35, 0.3)
 
-    def _support(self, cand: Candidate) -> tuple[int, float]:
-        """Observations and best confidence of target-labelled nodes near the candidate."""
+    def _support_confidence(self, cand: Candidate) -> float:
+        """Best confidence among the target-labelled nodes at the candidate's place."""
+        ids = self._support_ids(cand)
+        return max((float(o.confidence) for o in self.context.memory.objects if int(o.id) in ids), default=0.0)
+
+    def _count_frames(self, cand: Candidate) -> None:
+        """Judge each memory anchor (keyframe) made since the last tick: one with the candidate's
+        centre inside its camera's field of view adds to ``_in_view``, and one that also observed
+        a target-labelled node overlapping the candidate (``_support_ids``) adds to ``_fresh``.
+
+        Anchors, not the memory's version, are the frames: the version also moves when anchor
+        pruning removes keyframes, and those "frames" showed nothing, so a real fridge was
+        rejected as "detected in 3 of 8 frames" (ProcTHOR val/28/0). Each anchor is judged from
+        its own camera pose, not the robot's pose when the tick happens to look."""
         memory = self.context.memory
+        anchors = tuple(getattr(memory, "anchors", ()) or ())
+        if not anchors:
+            return
+        newest = max(int(a.id) for a in anchors)
+        if self._last_anchor is None:  # frames from before the robot came close do not count
+            self._last_anchor = newest
+            return
+        fresh = [a for a in anchors if int(a.id) > self._last_anchor]
+        if not fresh:
+            return
+        self._last_anchor = newest
+        support = self._support_ids(cand)
+        for a in sorted(fresh, key=lambda a: int(a.id)):
+            if _sees_point(a, cand.center, self.param("hfov_deg")):
+                self._in_view += 1
+                self._fresh += int(bool(support.intersection(int(i) for i in a.object_ids)))
+
+    def _support_ids(self, cand: Candidate) -> set[int]:
+        """Ids of the target-labelled nodes whose footprint overlaps the candidate's (grown by
+        ``support_margin``)."""
         labels = set(self.context.task.targets) if self.context.task is not None else {cand.label}
         labels.add(cand.label)
-        n, conf = 0, 0.0
         margin = self.param("support_margin")
         lo, hi = np.asarray(cand.box_min)[:2] - margin, np.asarray(cand.box_max)[:2] + margin
-        for o in memory.objects:
-            if o.label not in labels:
-                continue
-            o_lo, o_hi = np.asarray(o.box_min)[:2], np.asarray(o.box_max)[:2]
-            if np.all(o_lo <= hi) and np.all(o_hi >= lo):
-                n += int(o.n_obs)
-                conf = max(conf, float(o.confidence))
-        return n, conf
-
-    def _count_frames(self, cand: Candidate, support: int) -> None:
-        """Add the frames since the last tick to ``_in_view`` when the candidate is in view, and
-        the support gained to ``_fresh``."""
-        ctx = self.context
-        memory = ctx.memory
-        frame = getattr(memory, "version", None)  # counts the frames the memory integrated
-        pose = ctx.pose
-        if frame is None or pose is None or frame == self._frame:
-            return
-        new = 1 if self._frame is None else max(int(frame) - int(self._frame), 1)
-        self._frame = int(frame)
-        bearing = abs(wrap_angle(_facing(np.array([pose.x, pose.y]), cand.center) - pose.yaw))
-        if math.degrees(bearing) <= 0.5 * self.param("hfov_deg"):
-            self._in_view += new
-            self._fresh += max(support - self._support_prev, 0)
-        self._support_prev = support
+        return {int(o.id) for o in self.context.memory.objects if o.label in labels
+                and np.all(np.asarray(o.box_min)[:2] <= hi) and np.all(np.asarray(o.box_max)[:2] >= lo)}
 
     def _reject(self, why: str, permanent: bool) -> Status:
         cand = self._cand
@@ -394,17 +453,19 @@ class VerifyTarget(_GoToObject):
         if obj is None:
             return self._reject("object node disappeared from memory", True)
         if ctx.task is not None and obj.label not in ctx.task.targets and cand.source == "memory-label":
-            return self._reject(f"label is now {obj.label!r}", True)
+            # deferred, not rejected: a node's label is a vote over its observations and flips
+            # back and forth between confusable labels (a real fridge read as 'cabinet' for a
+            # while was rejected for good in val/1/2, and the robot explored out the house)
+            return self._reject(f"label is now {obj.label!r}", False)
         box_min, box_max = np.asarray(obj.box_min), np.asarray(obj.box_max)
         current = Candidate(cand.object_id, str(obj.label), np.asarray(obj.center, dtype=np.float64), box_min,
                             box_max, float(obj.confidence), int(obj.n_obs), cand.source)
         if ctx.distance_to_box(box_min, box_max) <= self.param("verify_distance") + 0.25:
-            support, conf = self._support(current)
-            if self._support_close is None:
-                self._support_close = self._support_prev = support
-            self._count_frames(current, support)
+            self._close = True
+            self._count_frames(current)
             fresh, frames = self._fresh, self._in_view
             if fresh >= self.param("min_fresh_views") and fresh >= self.param("min_detection_rate") * frames:
+                conf = self._support_confidence(current)
                 if conf >= self.param("min_confidence"):
                     self.write("target", current)
                     self.feedback_message = f"confirmed {obj.label} #{obj.id}: {fresh} fresh views in {frames} frames"
@@ -415,7 +476,7 @@ class VerifyTarget(_GoToObject):
         if ctx.now() - self._start > self.param("timeout_s"):
             return self._reject("no fresh views before the timeout", False)
         state = "pending" if self._seq is None else ctx.nav_state(self._seq)
-        if self._support_close is not None and state in ("reached", "failed"):
+        if self._close and state in ("reached", "failed"):
             # close: glance left and right of the target so that new frames (fresh views) arrive
             pose = ctx.pose
             face = _facing(np.array([pose.x, pose.y]), current.center)
@@ -441,6 +502,12 @@ class Approach(_GoToObject):
     it, or show a better candidate) instead of picking the same unreachable object again.
     """
 
+    # 1 m nearer the footprint's centre is worth 1 m more to drive: the robot stops in front of
+    # the object's middle, not off one of its ends (VerifyTarget keeps 0: pulled to the centre,
+    # its cells came nearer than the camera's minimum depth, where detections have no 3D points
+    # and no view counts; ProcTHOR val/2/0 rejected a real dresser so)
+    CENTRE_WEIGHT = 1.0
+
     PARAMS = {
         "distance": Param(float, 0.8, minimum=0.1, maximum=5.0, doc="stay below the success distance"),
         "facing_tolerance_deg": Param(float, 35.0, minimum=1.0, maximum=180.0),
@@ -449,23 +516,31 @@ class Approach(_GoToObject):
         "max_distance": Param(float, 1.5, minimum=0.1, maximum=5.0,
                               doc="settle this far at most when nothing closer is reachable"),
         "defer_s": Param(float, 30.0, minimum=0.0, maximum=3600.0, doc="an unreachable candidate waits this long"),
+        "arrive_radius": Param(float, 0.3, minimum=0.0, maximum=5.0,
+                               doc="done only this near the approach cell (when one was sent)"),
     }
 
     def initialise(self) -> None:
         self._start = self.context.now()
         self._seq = None
+        self._cell = None
         self._excluded: list[np.ndarray] = []
         self._attempts = 0
         self._turned = False
         self._ring = 0.0  # the approach ring the current goal came from (m)
 
     def _done(self, cand: Candidate) -> bool:
+        """Within ``distance`` (or the ring settled for) of the footprint, facing it, and at the
+        approach cell (``arrive_radius``) when one was sent: stopping at the first point within
+        the distance stopped the robot off the object's end on its way to a cell in front."""
         pose = self.context.pose
         if pose is None:
             return False
         close = self.context.distance_to_box(cand.box_min, cand.box_max) <= max(self.param("distance"), self._ring)
+        cell = getattr(self, "_cell", None)
+        arrived = cell is None or math.hypot(pose.x - cell[0], pose.y - cell[1]) <= self.param("arrive_radius")
         err = abs(wrap_angle(_facing(np.array([pose.x, pose.y]), cand.center) - pose.yaw))
-        return close and math.degrees(err) <= self.param("facing_tolerance_deg")
+        return close and arrived and math.degrees(err) <= self.param("facing_tolerance_deg")
 
     def update(self) -> Status:
         ctx = self.context
