@@ -161,7 +161,7 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     cmg = CognitiveMemoryGraph(mem_cfg, embedder=embedder)
 
     # exploration ------------------------------------------------------------------------------
-    planner = ExplorationPlanner(area_config(ExplorationConfig, overrides, "exploration"))
+    planner = ExplorationPlanner(area_config(ExplorationConfig, overrides, "exploration"), deterministic=stepped)
 
     # reasoning --------------------------------------------------------------------------------
     from hiconav.reasoning.config import ReasoningConfig

@@ -65,6 +65,8 @@ class OrderingConfig(BaseModel):
         "wtrp", description="ablation: WTRP order, highest weight first, or nearest first")
     solver: str = Field("auto", description="WTRP solver: auto | exact | ils | ortools | greedy | module:callable")
     time_limit: float = Field(0.2, gt=0.0, description="solver time limit (s) per plan")
+    stepped_restarts: int = Field(2, ge=1, description="on the stepped clock the ILS has no time limit and "
+                                  "runs this many starts instead, so an episode is the same on any machine")
     seed: int = 0
     switch_margin: float = Field(0.1, ge=0.0, description="switch goals only if the new order's objective is "
                                  "lower than keeping the current goal first by this fraction")

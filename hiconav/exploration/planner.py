@@ -29,7 +29,7 @@ import numpy as np
 from hiconav.exploration.config import ExplorationConfig
 from hiconav.exploration.cost import CostMatrix, GridLike, cost_matrix
 from hiconav.exploration.utility import AnchorLike, ObjectLike, frontier_utility, utility_weights
-from hiconav.exploration.wtrp import solve_wtrp, wtrp_cost
+from hiconav.exploration.wtrp import AUTO_EXACT_MAX_N, solve_wtrp, wtrp_cost
 from hiconav.types import Frontier, Goal, Pose2D, TaskSpec
 
 
@@ -79,10 +79,18 @@ class ExplorationPlan:
 
 
 class ExplorationPlanner:
-    """Frontier ordering with goal hysteresis (see module docstring)."""
+    """Frontier ordering with goal hysteresis (see module docstring).
 
-    def __init__(self, config: ExplorationConfig | None = None) -> None:
+    ``deterministic`` (the stepped clock): the ILS, which the "auto" and "ils" solvers use
+    above ``AUTO_EXACT_MAX_N`` frontiers, runs ``ordering.stepped_restarts`` starts with no
+    time limit instead of stopping at ``ordering.time_limit`` wall seconds. A wall-time limit
+    binds from about 30 frontiers on (0.2 s), so the order, and with it the episode, depended
+    on how fast and how busy the machine was; ``hiconav eval`` promises the same episode for
+    the same seed."""
+
+    def __init__(self, config: ExplorationConfig | None = None, *, deterministic: bool = False) -> None:
         self.config = config or ExplorationConfig()
+        self.deterministic = deterministic
         self.goal_id: int | None = None
         self.last_cost: CostMatrix | None = None  # diagnostics of the last call
 
@@ -101,7 +109,12 @@ class ExplorationPlanner:
             return tuple(int(i) for i in np.argsort(M[0, 1:], kind="stable") + 1), "nearest"
         if n == 0:
             return (), "none"
-        sol = solve_wtrp(M, W, method=ocfg.solver, time_limit=ocfg.time_limit, seed=ocfg.seed)
+        if self.deterministic and (ocfg.solver == "ils" or (ocfg.solver == "auto" and n > AUTO_EXACT_MAX_N)):
+            from hiconav.exploration.wtrp.ils import solve_ils  # numba: imported when first needed
+
+            sol = solve_ils(M, W, time_limit=None, max_restarts=ocfg.stepped_restarts, seed=ocfg.seed)
+        else:
+            sol = solve_wtrp(M, W, method=ocfg.solver, time_limit=ocfg.time_limit, seed=ocfg.seed)
         return sol.order, sol.method
 
     def plan(self, grid: GridLike, frontiers: Sequence[Frontier], snapshot: SnapshotLike | None,

@@ -141,3 +141,28 @@ def test_without_an_embedder_only_exact_target_labels_count() -> None:
         room(), [A, B], snap, TASK, Pose2D(5.5, 5.0, 0.0), np.zeros(2), None)
     assert out.s_struct[B.id] > 0.5 and out.goal.id == B.id
     assert out.s_struct[A.id] < 1e-3  # the nightstand scores 0 without an embedder
+
+
+def test_a_deterministic_planner_runs_the_ils_without_a_wall_time_limit(monkeypatch) -> None:
+    """The stepped clock's planner runs a fixed ILS schedule (no wall-time limit, a fixed number
+    of starts), so the order cannot depend on how fast or busy the machine is; the real-time
+    planner keeps its time limit."""
+    import hiconav.exploration.wtrp.ils as ils
+
+    calls = []
+    real = ils.solve_ils
+
+    def spy(M, W, **kw):
+        calls.append(kw)
+        return real(M, W, **kw)
+
+    monkeypatch.setattr(ils, "solve_ils", spy)
+    rng = np.random.default_rng(3)
+    xy = rng.uniform(1.0, 9.0, size=(40, 2))
+    frontiers = [Frontier(id=i, centroid=p, viewpoint=p, size=10) for i, p in enumerate(xy)]
+    cfg = ExplorationConfig(cost=CostConfig(stride=1))
+    orders = [plan(ExplorationPlanner(cfg, deterministic=True), 5.5, frontiers) for _ in range(2)]
+    assert orders[0].solver == "ils" and orders[0].order == orders[1].order
+    assert calls[0]["time_limit"] is None and calls[0]["max_restarts"] == cfg.ordering.stepped_restarts
+    plan(ExplorationPlanner(cfg), 5.5, frontiers)
+    assert calls[-1]["time_limit"] == cfg.ordering.time_limit
