@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hiconav.messages import PlanMsg, WorldSnapshot
-from hiconav.types import Frontier, Pose2D
+from hiconav.types import CameraIntrinsics, Frontier, Pose2D, camera_pose_from_base
 
 
 @dataclass
@@ -47,15 +47,12 @@ class FakeAnchor:
     id: int
     T_world_cam: np.ndarray
     object_ids: tuple = ()
+    intrinsics: CameraIntrinsics = CameraIntrinsics.from_hfov(640, 480, 79.0)
 
 
-def anchor(aid: int, pose: Pose2D, object_ids: tuple = ()) -> FakeAnchor:
-    """An anchor whose camera stands at the pose, looking along its yaw (optical axis = camera z)."""
-    T = np.eye(4)
-    T[:2, 2] = [np.cos(pose.yaw), np.sin(pose.yaw)]
-    T[2, 2] = 0.0
-    T[:2, 3] = [pose.x, pose.y]
-    return FakeAnchor(aid, T, tuple(object_ids))
+def anchor(aid: int, pose: Pose2D, object_ids: tuple = (), height: float = 0.4) -> FakeAnchor:
+    """An anchor whose camera stands at the pose, ``height`` m up, looking along its yaw."""
+    return FakeAnchor(aid, camera_pose_from_base(pose, height), tuple(object_ids))
 
 
 @dataclass(frozen=True)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+
+import numpy as np
 from pathlib import Path
 
 import py_trees
@@ -506,3 +508,54 @@ def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(t
     ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0)])
     assert not ctx.excluded(3)
     assert [c.object_id for c in ctx.candidates()] == [3]
+
+
+def test_anchor_sees_needs_the_point_in_the_image_and_no_box_in_the_way():
+    """A tv 1.9 m up is above the vertical field of view of a camera 0.88 m up and 1 m away; a
+    vase behind a chair is hidden; from 3 m away the tv is in view."""
+    import numpy as np
+    from hiconav.trees.behaviours.mission import anchor_sees
+
+    cam = anchor(1, Pose2D(0.0, 0.0, 0.0), height=0.88)
+    assert anchor_sees(cam, np.array([2.0, 0.0, 0.9]))
+    assert not anchor_sees(cam, np.array([1.0, 0.0, 1.9]))  # above the image
+    assert anchor_sees(anchor(2, Pose2D(-2.0, 0.0, 0.0), height=0.88), np.array([1.0, 0.0, 1.9]))
+    assert not anchor_sees(cam, np.array([-2.0, 0.0, 0.9]))  # behind the camera
+    chair = (np.array([[0.8, -0.3, 0.0]]), np.array([[1.3, 0.3, 0.94]]))
+    assert not anchor_sees(cam, np.array([2.0, 0.0, 0.88]), chair)
+    assert anchor_sees(cam, np.array([2.0, 1.0, 0.88]), chair)  # beside the chair
+    table = (np.array([[1.5, -0.5, 0.0]]), np.array([[2.5, 0.5, 0.7]]))
+    assert anchor_sees(cam, np.array([2.0, 0.0, 0.8]), table)  # on the table: its box does not hide it
+
+
+def test_verify_does_not_count_hidden_frames_and_moves_to_a_cell_that_sees(tmp_path):
+    """From behind a chair the camera cannot show the bed: those frames neither confirm nor
+    reject it, and after reposition_after of them the robot goes to another cell, one from
+    which the line of sight passes no memory object."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    pose = Pose2D(3.6, 5.0, 0.0)  # west of the bed at (5, 5), a chair between
+    chair = obj(9, "chair", 4.15, 5.0)
+    chair = type(chair)(9, "chair", chair.center, np.array([4.0, 4.8, 0.0]), np.array([4.3, 5.2, 1.0]))
+    objects = [obj(3, "bed", 5.0, 5.0), chair]
+    ctx.world = world(pose, objects, anchors=[anchor(1, pose, (3,))])
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - VerifyTarget: {max_view_frames: 3, reposition_after: 4}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    first = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    ctx.nav = NavStatus(first.seq, "reached", 0.0)
+    sent = len(ctx.outbox)
+    for aid in range(2, 6):  # four frames from behind the chair (glancing about): not in view
+        ctx.world = world(pose, objects, anchors=[anchor(aid, pose)])
+        assert tree.tick() == S.RUNNING
+        ctx.nav = NavStatus([m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].seq, "reached", 0.0)
+    tree.tick()
+    goals = [m.goal for m in ctx.outbox[sent:] if isinstance(m, GoalMsg) and m.goal is not None]
+    assert ctx.rejections == []  # hidden frames rejected nothing
+    moved = [g for g in goals if g.kind == "approach"]
+    assert moved, goals
+    g = moved[-1]
+    from hiconav.trees.behaviours.mission import segments_blocked
+
+    assert not segments_blocked(np.array([[g.x, g.y, 0.4]]), np.array([5.0, 5.0, 0.4]),
+                                chair.box_min[None, :] + [0.05, 0.05, 0.0], chair.box_max[None, :] - [0.05, 0.05, 0.0])[0]

@@ -25,7 +25,9 @@ from hiconav.types import Goal, wrap_angle
 
 def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy: np.ndarray,
                   max_distance: float, exclude: list[np.ndarray] | None = None,
-                  tight: bool = False, centre_weight: float = 0.0) -> np.ndarray | None:
+                  tight: bool = False, centre_weight: float = 0.0, prefer_xy: np.ndarray | None = None,
+                  prefer_weight: float = 0.0, sight: tuple[np.ndarray, float, np.ndarray, np.ndarray] | None = None
+                  ) -> np.ndarray | None:
     """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint.
 
     grid: snapshot with ``state`` (H, W) int8 (0 free), ``inflated`` (H, W) bool, ``origin`` (2,),
@@ -38,6 +40,10 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     ends: from a cell near the end of a painting 0.9 m long the robot sees it at a grazing
     angle past its wall, and on the ground truth such a cell is not a view point of it
     (ProcTHOR val/42/1 stopped 0.64 m from the painting's end and 1.12 m from success).
+    ``prefer_xy`` adds ``prefer_weight`` times the cell's distance to that point (a place the
+    object was seen from; see ``VerifyTarget``). ``sight`` = (point (3,), camera height, lo,
+    hi (m, 3)): when some candidate cells see the point over the boxes (``segments_blocked``
+    from the camera above the cell), only those are kept.
     """
     from scipy import ndimage
 
@@ -74,10 +80,20 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
         return None
     if tight and np.any(ok & roomy[r0:r1, c0:c1]):
         ok &= roomy[r0:r1, c0:c1]
+    if sight is not None:
+        point, height, lo, hi = sight
+        idx = np.flatnonzero(ok)
+        starts = np.stack([x.flat[idx], y.flat[idx], np.full(idx.size, float(height))], axis=1)
+        clear = ~segments_blocked(starts, point, lo, hi)
+        if clear.any():
+            ok = np.zeros_like(ok)
+            ok.flat[idx[clear]] = True
     cost = np.hypot(x - robot_xy[0], y - robot_xy[1])
     if centre_weight > 0.0:
         cx, cy = 0.5 * (box_min[0] + box_max[0]), 0.5 * (box_min[1] + box_max[1])
         cost = cost + centre_weight * np.hypot(x - cx, y - cy)
+    if prefer_xy is not None and prefer_weight > 0.0:
+        cost = cost + prefer_weight * np.hypot(x - prefer_xy[0], y - prefer_xy[1])
     cost = np.where(ok, cost, np.inf)
     i = int(np.argmin(cost))
     return np.array([x.flat[i], y.flat[i]])
@@ -87,16 +103,49 @@ def _facing(xy: np.ndarray, center: np.ndarray) -> float:
     return math.atan2(center[1] - xy[1], center[0] - xy[0])
 
 
-def _sees_point(anchor: Any, point: np.ndarray, hfov_deg: float) -> bool:
-    """True when ``point``'s (x, y) lies within half the field of view of the anchor camera's
-    optical axis projected on the floor (its T_world_cam: camera-to-world, z forward)."""
+def segments_blocked(starts: np.ndarray, end: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(n,) bool: the segment from each of ``starts`` (n, 3) to ``end`` (3,) passes through one
+    of the axis-aligned boxes ``lo`` / ``hi`` (m, 3) (slab test; a box containing either end
+    does not count, so the object itself and furniture the robot stands by never block)."""
+    starts = np.asarray(starts, dtype=np.float64).reshape(-1, 3)
+    lo = np.asarray(lo, dtype=np.float64).reshape(-1, 3)
+    hi = np.asarray(hi, dtype=np.float64).reshape(-1, 3)
+    if len(starts) == 0 or len(lo) == 0:
+        return np.zeros(len(starts), dtype=bool)
+    end = np.asarray(end, dtype=np.float64)
+    d = end[None, :] - starts  # (n, 3)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / np.where(np.abs(d) < 1e-12, 1e-12, d)
+        t0 = (lo[None, :, :] - starts[:, None, :]) * inv[:, None, :]  # (n, m, 3)
+        t1 = (hi[None, :, :] - starts[:, None, :]) * inv[:, None, :]
+    t_in = np.minimum(t0, t1).max(axis=2)
+    t_out = np.maximum(t0, t1).min(axis=2)
+    hit = (t_in <= t_out) & (t_in > 0.0) & (t_out < 1.0)  # entered and left strictly between the ends
+    return hit.any(axis=1)
+
+
+def anchor_sees(anchor: Any, point: np.ndarray, blockers: tuple[np.ndarray, np.ndarray] | None = None,
+                margin: float = 0.05) -> bool:
+    """True when ``point`` (3,) world projects inside the anchor's image (both fields of view,
+    ``margin`` of the size in from its edges) and, with ``blockers`` (lo, hi) boxes (m, 3), the
+    line from the camera to it passes through none of them.
+
+    A frame whose camera could not show the point says nothing about the object there: a tv
+    hung above the vertical field of view of a camera 1.2 m away, or a vase behind a chair
+    (ProcTHOR val/8/2, val/66/0), were rejected as 'detected in 0 of 8 frames' by a test that
+    looked at bearings only."""
     T = np.asarray(anchor.T_world_cam, dtype=np.float64)
-    axis = T[:2, 2]
-    rel = np.asarray(point, dtype=np.float64)[:2] - T[:2, 3]
-    if float(np.hypot(*axis)) < 1e-9 or float(np.hypot(*rel)) < 1e-9:
+    pc = T[:3, :3].T @ (np.asarray(point, dtype=np.float64)[:3] - T[:3, 3])
+    if pc[2] <= 1e-6:
         return False
-    bearing = abs(wrap_angle(math.atan2(rel[1], rel[0]) - math.atan2(axis[1], axis[0])))
-    return math.degrees(bearing) <= 0.5 * hfov_deg
+    K = anchor.intrinsics
+    u = (K.fx * pc[0] / pc[2] + K.cx) / K.width
+    v = (K.fy * pc[1] / pc[2] + K.cy) / K.height
+    if not (margin <= u <= 1.0 - margin and margin <= v <= 1.0 - margin):
+        return False
+    if blockers is None:
+        return True
+    return not bool(segments_blocked(T[None, :3, 3], point, *blockers)[0])
 
 
 @register_behaviour()
@@ -306,6 +355,16 @@ class _GoToObject(MissionBehaviour):
     READS = ("target",)
     # approach_cell's weight on a cell's distance to the footprint's centre (see Approach)
     CENTRE_WEIGHT = 0.0
+    # approach_cell's weight on a cell's distance to ``_preferred_xy`` (see VerifyTarget)
+    PREFER_WEIGHT = 0.0
+
+    def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
+        """A point the approach cell should lie near, or None (no preference)."""
+        return None
+
+    def _sight(self, cand: Candidate) -> tuple[np.ndarray, float, np.ndarray, np.ndarray] | None:
+        """approach_cell's ``sight`` argument, or None: cells need not see the candidate."""
+        return None
 
     def _send(self, cand: Candidate, distance: float) -> bool:
         ctx = self.context
@@ -313,11 +372,13 @@ class _GoToObject(MissionBehaviour):
         if pose is None or ctx.grid is None:
             return False
         robot = np.array([pose.x, pose.y])
-        cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded,
-                             centre_weight=self.CENTRE_WEIGHT)
+        prefer = self._preferred_xy(cand, distance)
+        kw = {"centre_weight": self.CENTRE_WEIGHT, "prefer_xy": prefer, "prefer_weight": self.PREFER_WEIGHT,
+              "sight": self._sight(cand)}
+        cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, **kw)
         if cell is None:  # furniture around it: a cell only the robot radius clears will do
             cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, tight=True,
-                                 centre_weight=self.CENTRE_WEIGHT)
+                                 **kw)
         if cell is None:
             return False
         self._cell = cell
@@ -342,13 +403,19 @@ class VerifyTarget(_GoToObject):
     spurious box lands at a random place in a random frame, so one that happened to fall on the
     candidate's place is outvoted by the frames that show nothing there. A candidate seen in too
     few of ``max_view_frames`` frames, or that vanishes from memory, is rejected for good (a
-    false positive); one whose label changed, or that cannot be reached or re-observed in time,
-    is deferred for ``defer_s`` (rejected for good after ``max_deferrals``), so exploration
-    resumes.
+    false positive); one whose label changed or whose confidence is low, or that cannot be
+    reached or re-observed in time, is deferred for ``defer_s`` (rejected for good after
+    ``max_deferrals``), so exploration resumes.
 
     Fresh views count only target-labelled nodes whose box overlaps the candidate's (grown by
     ``support_margin``): counting every same-label node within a radius let spurious boxes cast
     while the robot stares at a false candidate confirm it.
+
+    Only anchors whose camera could show the candidate count (``anchor_sees``: its centre in
+    the image, no other memory object's box on the line of sight). The view cell is chosen
+    far enough for the candidate's height to fit the vertical field of view, and among the
+    cells whose line of sight passes no memory object; after ``reposition_after`` anchors that
+    could not show the candidate the robot tries another cell (at most three).
     """
 
     PARAMS = {
@@ -358,13 +425,14 @@ class VerifyTarget(_GoToObject):
                                     doc="fresh views per frame with the candidate in view"),
         "max_view_frames": Param(int, 8, minimum=1, maximum=10000,
                                  doc="frames in view after which a rarely detected candidate is rejected"),
-        "hfov_deg": Param(float, 79.0, minimum=1.0, maximum=360.0, doc="the camera's horizontal field of view"),
         "min_confidence": Param(float, 0.3, minimum=0.0, maximum=1.0),
         "timeout_s": Param(float, 60.0, minimum=0.1, maximum=3600.0),
         "support_margin": Param(float, 0.15, minimum=0.0, maximum=2.0,
                                 doc="same-label nodes whose box overlaps the candidate's grown by this count"),
         "defer_s": Param(float, 30.0, minimum=0.0, maximum=3600.0),
         "max_deferrals": Param(int, 2, minimum=1, maximum=100),
+        "reposition_after": Param(int, 4, minimum=1, maximum=1000,
+                                  doc="anchors that could not show the candidate before trying another cell"),
     }
     WRITES = ("target",)
     READS = ()
@@ -381,12 +449,94 @@ class VerifyTarget(_GoToObject):
         self._last_anchor: int | None = None  # the newest memory anchor already judged
         self._fresh = 0  # anchors in view that observed the candidate
         self._in_view = 0  # anchors (keyframes) with the candidate in the field of view
+        self._unseen = 0  # anchors since the last goal whose camera could not show the candidate
         self._glance = 0
         if self._cand is not None and self.context.verify:
-            self._send(self._cand, self._goal_distance())
+            self._send(self._cand, self._goal_distance(self._cand))
 
-    def _goal_distance(self) -> float:
-        return max(self.param("verify_distance") - 0.35, 0.3)
+    def _goal_distance(self, cand: Candidate) -> float:
+        """The ring (m from the footprint) to view the candidate from: ``verify_distance`` less
+        0.35 m, or farther for an object high above (or far below) the camera, so that its
+        centre is inside the vertical field of view with 8 degrees to spare (a tv 1.9 m up is
+        out of view from 1.2 m for a camera at 0.88 m with a 63 degree field)."""
+        base = max(self.param("verify_distance") - 0.35, 0.3)
+        camera = self._camera()
+        if camera is None:
+            return base
+        height, vfov = camera
+        half = max(0.5 * vfov - math.radians(8.0), math.radians(5.0))
+        need = abs(float(np.asarray(cand.center)[2]) - height) / math.tan(half)
+        return max(base, min(need, 4.0))
+
+    def _close_distance(self, cand: Candidate) -> float:
+        """Within this distance of the footprint the robot judges the candidate's views."""
+        return max(self.param("verify_distance"), self._goal_distance(cand) + 0.35) + 0.25
+
+    def _camera(self) -> tuple[float, float] | None:
+        """(camera height m, vertical field of view rad) from the newest memory anchor, or None."""
+        anchors = tuple(getattr(self.context.memory, "anchors", ()) or ())
+        if not anchors:
+            return None
+        a = max(anchors, key=lambda a: int(a.id))
+        K = getattr(a, "intrinsics", None)
+        if K is None:
+            return None
+        return float(np.asarray(a.T_world_cam)[2, 3]), 2.0 * math.atan2(K.height / 2.0, K.fy)
+
+    def _blockers(self, cand: Candidate) -> tuple[np.ndarray, np.ndarray] | None:
+        """3D boxes (lo, hi) of the memory's other objects, shrunk by 5 cm a side horizontally:
+        what may hide the candidate from a camera (its own target-labelled nodes, and objects
+        whose footprint overlaps its own, never do)."""
+        support = self._support_ids(cand) | {int(cand.object_id)}
+        c_lo, c_hi = np.asarray(cand.box_min)[:2] - 0.05, np.asarray(cand.box_max)[:2] + 0.05
+        boxes = [(np.asarray(o.box_min, dtype=np.float64), np.asarray(o.box_max, dtype=np.float64))
+                 for o in self.context.memory.objects if int(o.id) not in support]
+        # what it stands on or hangs from (a footprint overlapping its own) never hides it: the
+        # line to a laptop's centre grazes the top of the desk box under it (val/82/0)
+        boxes = [b for b in boxes if not (np.all(b[0][:2] <= c_hi) and np.all(b[1][:2] >= c_lo))]
+        if not boxes:
+            return None
+        shrink = np.array([0.05, 0.05, 0.0])
+        lo = np.array([b[0] for b in boxes]) + shrink
+        hi = np.array([b[1] for b in boxes]) - shrink
+        keep = np.all(hi > lo, axis=1)
+        return (lo[keep], hi[keep]) if keep.any() else None
+
+    def _sight(self, cand: Candidate) -> tuple[np.ndarray, float, np.ndarray, np.ndarray] | None:
+        camera, blockers = self._camera(), self._blockers(cand)
+        if camera is None or blockers is None:
+            return None
+        return np.asarray(cand.center, dtype=np.float64), camera[0], blockers[0], blockers[1]
+
+    # 1 m nearer the line the candidate was seen along is worth 2 m more to drive
+    PREFER_WEIGHT = 2.0
+
+    def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
+        """The point ``distance`` from the candidate's centre toward the camera of a memory
+        anchor that observed it (the anchor whose camera stood nearest that distance).
+
+        The line along which the object was detected was clear; a cell on it, nearer, most
+        likely sees the object too. The nearest free cell to the robot often did not: in
+        ProcTHOR val/66/0 it stood behind a chair that hid the vase on the dining table, and 8
+        frames without it rejected a real vase."""
+        memory = self.context.memory
+        obj = self.context.object(cand.object_id)
+        ids = set(int(i) for i in getattr(obj, "anchor_ids", ()) or ())
+        if memory is None or not ids:
+            return None
+        centre = np.asarray(cand.center, dtype=np.float64)[:2]
+        best, best_err = None, math.inf
+        for a in getattr(memory, "anchors", ()) or ():
+            if int(a.id) not in ids:
+                continue
+            cam = np.asarray(a.T_world_cam, dtype=np.float64)[:2, 3]
+            d = float(np.hypot(*(cam - centre)))
+            if d > 1e-6 and abs(d - distance) < best_err:
+                best, best_err = cam, abs(d - distance)
+        if best is None:
+            return None
+        u = (best - centre) / float(np.hypot(*(best - centre)))
+        return centre + u * min(float(np.hypot(*(best - centre))), distance)
 
     def _support_confidence(self, cand: Candidate) -> float:
         """Best confidence among the target-labelled nodes at the candidate's place."""
@@ -394,9 +544,10 @@ class VerifyTarget(_GoToObject):
         return max((float(o.confidence) for o in self.context.memory.objects if int(o.id) in ids), default=0.0)
 
     def _count_frames(self, cand: Candidate) -> None:
-        """Judge each memory anchor (keyframe) made since the last tick: one with the candidate's
-        centre inside its camera's field of view adds to ``_in_view``, and one that also observed
-        a target-labelled node overlapping the candidate (``_support_ids``) adds to ``_fresh``.
+        """Judge each memory anchor (keyframe) made since the last tick: one whose camera could
+        show the candidate's centre (inside its image, not behind another memory object:
+        ``anchor_sees``) adds to ``_in_view``, and one that also observed a target-labelled
+        node overlapping the candidate (``_support_ids``) adds to ``_fresh``.
 
         Anchors, not the memory's version, are the frames: the version also moves when anchor
         pruning removes keyframes, and those "frames" showed nothing, so a real fridge was
@@ -415,10 +566,13 @@ class VerifyTarget(_GoToObject):
             return
         self._last_anchor = newest
         support = self._support_ids(cand)
+        blockers = self._blockers(cand)
         for a in sorted(fresh, key=lambda a: int(a.id)):
-            if _sees_point(a, cand.center, self.param("hfov_deg")):
+            if anchor_sees(a, cand.center, blockers):
                 self._in_view += 1
                 self._fresh += int(bool(support.intersection(int(i) for i in a.object_ids)))
+            else:
+                self._unseen += 1
 
     def _support_ids(self, cand: Candidate) -> set[int]:
         """Ids of the target-labelled nodes whose footprint overlaps the candidate's (grown by
@@ -460,7 +614,7 @@ class VerifyTarget(_GoToObject):
         box_min, box_max = np.asarray(obj.box_min), np.asarray(obj.box_max)
         current = Candidate(cand.object_id, str(obj.label), np.asarray(obj.center, dtype=np.float64), box_min,
                             box_max, float(obj.confidence), int(obj.n_obs), cand.source)
-        if ctx.distance_to_box(box_min, box_max) <= self.param("verify_distance") + 0.25:
+        if ctx.distance_to_box(box_min, box_max) <= self._close_distance(current):
             self._close = True
             self._count_frames(current)
             fresh, frames = self._fresh, self._in_view
@@ -470,12 +624,23 @@ class VerifyTarget(_GoToObject):
                     self.write("target", current)
                     self.feedback_message = f"confirmed {obj.label} #{obj.id}: {fresh} fresh views in {frames} frames"
                     return Status.SUCCESS
-                return self._reject(f"confidence {conf:.2f} below {self.param('min_confidence')}", True)
+                # deferred: the views were fresh; the oracle and real detectors score small objects
+                # low, and a laptop seen 14 times was rejected for good at 0.29 (val/26/2)
+                return self._reject(f"confidence {conf:.2f} below {self.param('min_confidence')}", False)
             if frames >= self.param("max_view_frames"):
                 return self._reject(f"detected in {fresh} of {frames} frames in view", True)
         if ctx.now() - self._start > self.param("timeout_s"):
             return self._reject("no fresh views before the timeout", False)
         state = "pending" if self._seq is None else ctx.nav_state(self._seq)
+        if self._close and state in ("reached", "failed") and self._unseen >= self.param("reposition_after") \
+                and getattr(self, "_cell", None) is not None and len(self._excluded) < 3:
+            # from here the camera cannot show it (hidden behind furniture the memory now knows,
+            # or out of the field of view): view it from another cell, one that sees it
+            self._excluded.append(self._cell)
+            self._unseen = 0
+            if self._send(current, self._goal_distance(current)):
+                self.feedback_message = f"verifying {cand.label} #{cand.object_id} from another cell"
+                return Status.RUNNING
         if self._close and state in ("reached", "failed"):
             # close: glance left and right of the target so that new frames (fresh views) arrive
             pose = ctx.pose
@@ -486,7 +651,7 @@ class VerifyTarget(_GoToObject):
         elif self._seq is None or state in ("failed", "reached"):
             if self._seq is not None and getattr(self, "_cell", None) is not None:
                 self._excluded.append(self._cell)
-            if len(self._excluded) > 3 or not self._send(current, self._goal_distance()):
+            if len(self._excluded) > 3 or not self._send(current, self._goal_distance(current)):
                 if ctx.grid is not None and ctx.pose is not None:
                     return self._reject("no reachable view point", False)
         self.feedback_message = f"verifying {cand.label} #{cand.object_id}"
