@@ -281,7 +281,13 @@ def box_footprint_cells(nav: NavGrid, obj: SimObject) -> np.ndarray:
 
 def rasterize_polygon(shape: tuple[int, int], origin: np.ndarray, res: float,
                       polygon: np.ndarray) -> np.ndarray:
-    """(H, W) bool: cells whose centre lies inside ``polygon`` ((N, 2) world xy)."""
+    """(H, W) bool: cells whose centre lies inside ``polygon`` ((N, 2) world xy).
+
+    A centre on the boundary belongs to the polygon on its +x / +y side (the centres are tested
+    1 um up and right): matplotlib leaves boundary points out of every polygon, so where two
+    rooms meet exactly on a row or column of cell centres, a seam without floor split them, and
+    the doorway in that wall was a wall on the navigable grid while the renderer showed it open
+    (ProcTHOR val/52: the robot rocked in front of a door it saw but could not pass)."""
     from matplotlib.path import Path as MplPath
 
     h, w = shape
@@ -296,7 +302,7 @@ def rasterize_polygon(shape: tuple[int, int], origin: np.ndarray, res: float,
     if c1 <= c0 or r1 <= r0:
         return out
     gx, gy = np.meshgrid(xs[c0:c1], ys[r0:r1])
-    inside = MplPath(poly).contains_points(np.stack([gx.ravel(), gy.ravel()], axis=1))
+    inside = MplPath(poly).contains_points(np.stack([gx.ravel() + 1e-6, gy.ravel() + 1e-6], axis=1))
     out[r0:r1, c0:c1] = inside.reshape(gy.shape)
     return out
 

@@ -68,14 +68,16 @@ def test_objaverse_objects_get_the_default_box(shared_data):
 
 
 def test_doors_connect_the_rooms_they_name(shared_data):
-    """The two rooms of every interior door share one navigable component (the hole is open)."""
+    """The two rooms of every interior door share one navigable component (the hole is open).
+    val/52 and val/90 have rooms that meet exactly on a column of cell centres: a floor seam
+    there once closed their doors on the navigable grid while the renderer showed them open."""
     from scipy import ndimage
 
     from hiconav.sim.house import rasterize_polygon
 
     lines = _lines(shared_data, "val")
     checked = 0
-    for i in range(0, 100, 7):
+    for i in sorted(set(range(0, 100, 7)) | {52, 90}):
         src = json.loads(lines[i])
         house = load_house(f"procthor:val/{i}", shared_data)
         labels, _ = ndimage.label(house.nav.navigable, structure=np.ones((3, 3), bool))
