@@ -86,6 +86,10 @@ class MissionContext:
     # quarter turns in place done at the mission's start (Explore's start_look_turns); shared by
     # every Explore instance, so the look-around happens once per mission
     start_looks: int = 0
+    # where Explore last turned in place for want of a frontier, and how many quarter turns it
+    # made there (look_turns at most per spot, for the whole mission)
+    look_spot: tuple[float, float] | None = None
+    looks_here: int = 0
 
     # -- time and pose -------------------------------------------------------------------------
     def now(self) -> float:

@@ -164,15 +164,18 @@ class Navigator:
         if not (0 <= start[0] < h and 0 <= start[1] < w) or not (0 <= goal[0] < h and 0 <= goal[1] < w):
             self.path_xy, self._dense_xy, self.status = None, None, "no_path"
             return False
-        for tight in (False, True) if self.config.tight_fallback else (False,):
-            found = self._plan_on(grid, start, goal, tight)
-            if found is not None:
-                blocked, cells = found
-                self.tight = tight
-                break
-        else:
+        found = self._search(grid, start, goal)
+        if found is None and self._virtual:
+            # the virtual obstacles left by stuck steps may have walled the robot in (a corner of
+            # ProcTHOR val/52/1 held it for 400 steps): clear them, as a costmap-clearing recovery
+            # does, and plan once more on what the sensors saw
+            log.info("navigator: no path with %d virtual obstacles; cleared them", len(self._virtual))
+            self._virtual.clear()
+            found = self._search(grid, start, goal)
+        if found is None:
             self.path_xy, self._dense_xy, self.status = None, None, "no_path"
             return False
+        blocked, cells = found
         way = smooth_path(blocked, cells)
         path = grid.cell_to_world(way)
         path[0] = pose.xy
@@ -180,6 +183,15 @@ class Navigator:
         self._dense_xy = grid.cell_to_world(cells[1:]) if len(cells) > 1 else grid.cell_to_world(cells)
         self.status = "following"
         return True
+
+    def _search(self, grid: GridLike, start: np.ndarray, goal: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """(blocked mask, A* cells) on the normal mask, then the tight one; sets ``tight``."""
+        for tight in (False, True) if self.config.tight_fallback else (False,):
+            found = self._plan_on(grid, start, goal, tight)
+            if found is not None:
+                self.tight = tight
+                return found
+        return None
 
     def _plan_on(self, grid: GridLike, start: np.ndarray, goal: np.ndarray,
                  tight: bool) -> tuple[np.ndarray, np.ndarray] | None:

@@ -232,3 +232,16 @@ def test_a_diagonal_path_is_followed_without_zig_zag():
     assert old_ok and new_ok
     assert new_turns <= 8 and old_turns >= 15, (new_turns, old_turns)  # measured: 5 vs 23
     assert new_turns + new_fwd < old_turns + old_fwd
+
+
+def test_virtual_obstacles_that_wall_the_robot_in_are_cleared_when_no_path_is_left():
+    """Stuck steps leave virtual obstacles; once they close every way out, the navigator clears
+    them and plans on what the sensors saw instead of reporting no path for good."""
+    s = open_room()
+    nav = Navigator()
+    nav.set_goal(Goal(4.0, 2.5))
+    pose = Pose2D(1.0, 2.5, 0.0)
+    for yaw in np.linspace(0.0, 2 * math.pi, 16, endpoint=False):  # a ring of them round the robot
+        nav._add_virtual_obstacle(Pose2D(pose.x, pose.y, float(yaw)))
+    assert nav.step(snapshot(s), pose) != DiscreteAction.STOP
+    assert nav.status == "following" and nav._virtual == []

@@ -559,3 +559,58 @@ def test_verify_does_not_count_hidden_frames_and_moves_to_a_cell_that_sees(tmp_p
 
     assert not segments_blocked(np.array([[g.x, g.y, 0.4]]), np.array([5.0, 5.0, 0.4]),
                                 chair.box_min[None, :] + [0.05, 0.05, 0.0], chair.box_max[None, :] - [0.05, 0.05, 0.0])[0]
+
+
+def test_explore_turns_look_turns_times_per_spot_for_the_whole_mission(tmp_path):
+    """With no frontier to pick, Explore turns in place look_turns times at a spot, counted by
+    the mission: new Explore instances (retries) at the same spot do not turn again."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan()  # no frontier
+    looks = 0
+    for retry in range(3):
+        tree = MissionTree(_write(tmp_path, "root:\n  Explore: {look_turns: 2, max_idle_s: 100}\n"), ctx)
+        for _ in range(6):
+            clock.t += 1.0
+            tree.tick()
+            goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)]
+            if goal and goal[-1].goal is not None and goal[-1].goal.kind == "look" and \
+                    ctx.nav_state(goal[-1].seq) == "pending":
+                looks += 1
+                ctx.nav = NavStatus(goal[-1].seq, "reached", 0.0)
+        tree.stop()
+    assert looks == 2 and ctx.looks_here == 2
+    ctx.world = world(Pose2D(6.0, 6.0, 0.0))  # elsewhere: two more
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {look_turns: 2, max_idle_s: 100}\n"), ctx)
+    tree.tick()
+    assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.kind == "look" and ctx.looks_here == 1
+
+
+def test_explored_out_explore_brings_deferred_candidates_back_before_failing(tmp_path):
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = plan()
+    ctx.reject(3, "label is now 'sofa'", permanent=False, defer_s=30.0)
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {look_turns: 0, max_idle_s: 2}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    clock.t = 3.0
+    assert tree.tick() == S.RUNNING  # not FAILURE: the deferred candidate is due now
+    assert not ctx.excluded(3)
+    clock.t = 6.0
+    assert tree.tick() == S.FAILURE  # nothing deferred any more: explored out
+
+
+def test_verify_defers_a_candidate_it_gets_no_nearer_to(tmp_path):
+    """A robot rocking in a doorway it cannot pass makes no progress toward the view cell: after
+    STALL_S the candidate is deferred (the behaviours' timeouts outlast a 500-step episode)."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.world = world(Pose2D(1.0, 1.0, 0.0), [obj(3, "bed", 8.0, 8.0)])
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - VerifyTarget: {}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    for k in range(1, 8):
+        clock.t = float(k)
+        ctx.world = world(Pose2D(1.0 + 0.1 * (k % 2), 1.0, 0.0), [obj(3, "bed", 8.0, 8.0)])
+        status = tree.tick()
+    assert status == S.FAILURE and "no progress" in ctx.rejections[-1][1] and 3 not in ctx.rejected

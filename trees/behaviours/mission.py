@@ -241,7 +241,6 @@ class Explore(MissionBehaviour):
         if self.context.last_frontier_time is None:
             self.context.last_frontier_time = self.context.now()
         self._visited: set[int] = set()
-        self._looks = 0
         self._reached: list[tuple[np.ndarray, float]] = []  # viewpoint, clock time: awaiting a newer plan
         self._start_look = False  # the goal in flight is one of the start's quarter turns
 
@@ -321,19 +320,32 @@ class Explore(MissionBehaviour):
                 ctx.send_goal(None)
                 self._seq = None
             if now - ctx.last_frontier_time > self.param("max_idle_s"):  # set in initialise
+                if ctx.deferred:
+                    # explored out: a deferred candidate is all that is left, so try it again now
+                    # rather than end the mission (val/1/2: a fridge deferred for a label flip
+                    # was still waiting when the small house had no frontier left)
+                    ctx.log(f"no frontier left: deferred candidates {sorted(ctx.deferred)} are due now")
+                    ctx.deferred.clear()
+                    ctx.last_frontier_time = now
+                    self.feedback_message = "no frontier left: back to the deferred candidates"
+                    return Status.RUNNING
                 self.feedback_message = "no frontier left"
                 return Status.FAILURE
             pose = ctx.pose
-            if self._seq is None and pose is not None and self._looks < self.param("look_turns"):
-                # no frontier in view: turn in place (a quarter turn per look) to see around
-                self._looks += 1
+            if pose is not None and (ctx.look_spot is None or
+                                     math.hypot(pose.x - ctx.look_spot[0], pose.y - ctx.look_spot[1]) > 1.0):
+                ctx.look_spot, ctx.looks_here = (pose.x, pose.y), 0
+            if self._seq is None and pose is not None and ctx.looks_here < self.param("look_turns"):
+                # no frontier in view: turn in place (a quarter turn per look) to see around; the
+                # count is the mission's, per spot, so a frontier that flickers in and out of the
+                # plan cannot make the robot spin for the rest of the episode (val/52/1: 400 turns)
+                ctx.looks_here += 1
                 self._frontier, self._goal_xy = None, None
                 self._seq = ctx.send_goal(Goal(pose.x, pose.y, wrap_angle(pose.yaw + math.pi / 2), 0.5, "look"))
                 ctx.last_frontier_time = now  # looking around is progress
             self.feedback_message = "looking around" if self._seq is not None else "waiting for a frontier"
             return Status.RUNNING
         ctx.last_frontier_time = now
-        self._looks = 0
         fid, xy, yaw = pick
         moved = self._goal_xy is None or float(np.hypot(*(xy - self._goal_xy))) > self.param("switch_distance")
         if self._seq is None or fid != self._frontier or moved:
@@ -382,9 +394,27 @@ class _GoToObject(MissionBehaviour):
         if cell is None:
             return False
         self._cell = cell
+        self._progress: tuple[float, float] | None = None  # (best distance to the cell, clock time)
         self._seq = ctx.send_goal(Goal(float(cell[0]), float(cell[1]), _facing(cell, cand.center), 0.2,
                                        "approach", cand.object_id))
         return True
+
+    # a goal cell the robot has come no nearer to (by 0.25 m) for this many clock seconds counts
+    # as failed: a navigator rocking in a doorway held ProcTHOR val/52/1 for 350 steps, while
+    # the behaviours' timeouts (60 s, 120 s of clock) outlast a 500-step episode (~0.1 s a step)
+    STALL_S = 6.0
+
+    def _stalled(self) -> bool:
+        """True when the robot has made no progress toward the goal cell for ``STALL_S``."""
+        pose, cell = self.context.pose, getattr(self, "_cell", None)
+        if pose is None or cell is None or getattr(self, "_seq", None) is None:
+            return False
+        d, now = math.hypot(pose.x - cell[0], pose.y - cell[1]), self.context.now()
+        best = getattr(self, "_progress", None)
+        if best is None or d < best[0] - 0.25 or d <= 0.35:  # progress, or there (glancing about)
+            self._progress = (d, now)
+            return False
+        return now - best[1] > self.STALL_S
 
     def cleanup(self, new_status: Status) -> None:
         if getattr(self, "_seq", None) is not None and self.ctx is not None and new_status != Status.SUCCESS:
@@ -415,7 +445,8 @@ class VerifyTarget(_GoToObject):
     the image, no other memory object's box on the line of sight). The view cell is chosen
     far enough for the candidate's height to fit the vertical field of view, and among the
     cells whose line of sight passes no memory object; after ``reposition_after`` anchors that
-    could not show the candidate the robot tries another cell (at most three).
+    could not show the candidate the robot tries another cell, and after three cells it defers
+    the candidate.
     """
 
     PARAMS = {
@@ -633,6 +664,11 @@ class VerifyTarget(_GoToObject):
             return self._reject("no fresh views before the timeout", False)
         state = "pending" if self._seq is None else ctx.nav_state(self._seq)
         if self._close and state in ("reached", "failed") and self._unseen >= self.param("reposition_after") \
+                and len(self._excluded) >= 3:
+            # three cells tried and none shows it: come back later instead of glancing at it
+            # until the timeout (a hidden false candidate held val/52/1 for 300 steps)
+            return self._reject("no view cell shows it", False)
+        if self._close and state in ("reached", "failed") and self._unseen >= self.param("reposition_after") \
                 and getattr(self, "_cell", None) is not None and len(self._excluded) < 3:
             # from here the camera cannot show it (hidden behind furniture the memory now knows,
             # or out of the field of view): view it from another cell, one that sees it
@@ -648,7 +684,11 @@ class VerifyTarget(_GoToObject):
             offset = math.radians(self._GLANCES[self._glance % len(self._GLANCES)])
             self._glance += 1
             self._seq = ctx.send_goal(Goal(pose.x, pose.y, wrap_angle(face + offset), 0.5, "look", cand.object_id))
-        elif self._seq is None or state in ("failed", "reached"):
+        elif not self._close and self._stalled():
+            # no nearer in STALL_S on the way to it: whatever blocks the way (a doorway the
+            # robot cannot pass) blocks the other cells by it too; explore on, come back later
+            return self._reject("no progress toward a view cell", False)
+        elif self._seq is None or state in ("failed", "reached") or self._stalled():
             if self._seq is not None and getattr(self, "_cell", None) is not None:
                 self._excluded.append(self._cell)
             if len(self._excluded) > 3 or not self._send(current, self._goal_distance(current)):
@@ -719,7 +759,7 @@ class Approach(_GoToObject):
         if ctx.now() - self._start > self.param("timeout_s"):
             return self._give_up(cand, "timed out")
         state = "pending" if self._seq is None else ctx.nav_state(self._seq)
-        if self._seq is None or state in ("failed", "reached"):
+        if self._seq is None or state in ("failed", "reached") or self._stalled():
             if self._seq is not None and getattr(self, "_cell", None) is not None:
                 self._excluded.append(self._cell)
             self._attempts += 1
