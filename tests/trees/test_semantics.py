@@ -614,3 +614,36 @@ def test_verify_defers_a_candidate_it_gets_no_nearer_to(tmp_path):
         ctx.world = world(Pose2D(1.0 + 0.1 * (k % 2), 1.0, 0.0), [obj(3, "bed", 8.0, 8.0)])
         status = tree.tick()
     assert status == S.FAILURE and "no progress" in ctx.rejections[-1][1] and 3 not in ctx.rejected
+
+
+def test_approach_goes_to_its_cell_even_when_it_starts_within_the_distance(tmp_path):
+    """Approach starting 0.7 m off the bed's side, facing it, still goes to its approach cell
+    (it stopped where VerifyTarget had left it, off a painting's end, in val/65/2)."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    start = Pose2D(3.8, 4.9, math.atan2(0.1, 1.2))
+    ctx.world = world(start, [obj(3, "bed", 5.0, 5.0)])
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        "      - Approach: {distance: 0.8}\n"), ctx)
+    assert tree.tick() == S.RUNNING
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert goal.kind == "approach" and math.hypot(goal.x - start.x, goal.y - start.y) > 0.3
+
+
+def test_wall_clear_sees_past_known_furniture_but_not_past_walls():
+    """The 2D line of sight from an approach cell: occupied cells inside memory objects' boxes
+    (a table) are see-through, the rest (a wall) are not."""
+    from hiconav.trees.behaviours.mission import wall_clear
+
+    from .fakes import open_grid
+
+    grid = open_grid()
+    grid.state[20:80, 50] = 1  # a wall at x = 5.0 m
+    grid.state[45:55, 30:35] = 1  # a table at x 3.0-3.5, y 4.5-5.5
+    table = (np.array([3.0, 4.5, 0.0]), np.array([3.5, 5.5, 0.7]))
+    chair = (np.array([5.6, 4.8, 0.0]), np.array([6.0, 5.2, 0.9]))
+    cells = np.array([[2.0, 5.0], [5.5, 6.0], [4.5, 5.0]])
+    clear = wall_clear(grid, cells, np.array([5.8, 5.0]), [chair, table])
+    assert clear.tolist() == [False, True, False]  # behind the wall; same side; behind the wall
+    assert wall_clear(grid, np.array([[2.0, 5.0]]), np.array([4.0, 5.0]), [table]).tolist() == [True]
+    assert wall_clear(grid, np.array([[2.0, 5.0]]), np.array([4.0, 5.0]), []).tolist() == [False]
