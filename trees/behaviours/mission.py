@@ -827,8 +827,14 @@ class Approach(_GoToObject):
             rings += [r for r in (1.0, 1.25, 1.5, 2.0) if distance < r <= self.param("max_distance")]
             sent = False
             if self._attempts <= self.param("max_attempts"):
-                # every ring with no wall between cell and target first; then any cell at all
-                for strict, ring in [(True, r) for r in rings] + [(False, r) for r in rings]:
+                # cells with no wall between them and the target first, out to 1 m (a cell behind
+                # a wall is never by the target; one a little farther that sees it may be); then
+                # any cell within the distance; then the rest
+                order = [(True, r) for r in rings if r <= max(distance, 1.0)]
+                order += [(False, r) for r in rings if r <= distance]
+                order += [(strict, r) for strict in (True, False) for r in rings
+                          if r > distance and (strict, r) not in order]
+                for strict, ring in order:
                     if self._send(cand, ring, strict_walls=strict):
                         self._ring, sent = ring, True
                         break
