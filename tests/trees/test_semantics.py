@@ -41,6 +41,21 @@ def _ctx(clock: Clock, **kw) -> MissionContext:
     return ctx
 
 
+def _confirmed_then(tmp_path: Path, ctx: MissionContext, leaf: str) -> MissionTree:
+    """The tree TargetConfirmed -> ``leaf`` (one YAML line, e.g. "Approach: {distance: 0.8}")."""
+    return MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
+                                        f"      - {leaf}\n"), ctx)
+
+
+def _approach_bed(tmp_path: Path, pose: Pose2D) -> tuple[MissionContext, MissionTree, object]:
+    """Approach (0.8 m) to a bed at (5, 5) from ``pose``: context, tree and the first goal sent."""
+    ctx = _ctx(Clock())
+    ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0)])
+    tree = _confirmed_then(tmp_path, ctx, "Approach: {distance: 0.8}")
+    assert tree.tick() == S.RUNNING
+    return ctx, tree, [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+
+
 def _node(tree: MissionTree, name: str):
     return next(n for n in tree.root.iterate() if n.name == name)
 
@@ -160,8 +175,7 @@ def _verify_tree(tmp_path, clock: Clock, params: str, pose: Pose2D = FACING_BED)
     """A context with one bed node (seen by anchor 1) and TargetConfirmed -> VerifyTarget."""
     ctx = _ctx(clock)
     ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0)], anchors=[anchor(1, pose, (3,))])
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        f"      - VerifyTarget: {{{params}}}\n"), ctx)
+    tree = _confirmed_then(tmp_path, ctx, f"VerifyTarget: {{{params}}}")
     return ctx, tree
 
 
@@ -220,13 +234,7 @@ def test_verify_judges_each_anchor_from_its_own_camera_and_ignores_pruning(tmp_p
 
 
 def test_approach_sends_a_free_cell_within_distance_facing_the_target(tmp_path):
-    clock = Clock()
-    ctx = _ctx(clock)
-    ctx.world = world(Pose2D(1.5, 1.5, 0.0), [obj(3, "bed", 5.0, 5.0)])
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - Approach: {distance: 0.8}\n"), ctx)
-    assert tree.tick() == S.RUNNING
-    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    ctx, tree, goal = _approach_bed(tmp_path, Pose2D(1.5, 1.5, 0.0))
     assert goal.kind == "approach"
     dx = max(4.5 - goal.x, 0, goal.x - 5.5)
     dy = max(4.5 - goal.y, 0, goal.y - 5.5)
@@ -327,8 +335,7 @@ def test_an_unreachable_candidate_is_deferred_by_approach_so_exploration_goes_on
     state[10:30, 10:30] = 0
     grid = FakeGrid(state, np.zeros_like(state, dtype=bool))
     ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 8.0, 8.0)], grid=grid)
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - Approach: {distance: 0.8, defer_s: 30}\n"), ctx)
+    tree = _confirmed_then(tmp_path, ctx, "Approach: {distance: 0.8, defer_s: 30}")
     assert tree.tick() == S.FAILURE
     assert ctx.excluded(3) and 3 not in ctx.rejected  # deferred, not rejected for good
     assert "approach" in ctx.rejections[-1][1]
@@ -475,13 +482,7 @@ def test_approach_cell_prefers_the_front_of_an_objects_middle_over_its_near_end(
 
 def test_approach_is_not_done_on_passing_within_the_distance_off_the_target(tmp_path):
     """Done at the approach cell, not at the first point within the distance of the footprint."""
-    clock = Clock()
-    ctx = _ctx(clock)
-    ctx.world = world(Pose2D(1.5, 1.5, 0.0), [obj(3, "bed", 5.0, 5.0)])
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - Approach: {distance: 0.8}\n"), ctx)
-    assert tree.tick() == S.RUNNING
-    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    ctx, tree, goal = _approach_bed(tmp_path, Pose2D(1.5, 1.5, 0.0))
     # a point 0.7 m off the bed's side, facing it, 0.8 m from the cell: not there yet
     passing = Pose2D(3.8, 4.9, math.atan2(0.1, 1.2))
     assert math.hypot(passing.x - goal.x, passing.y - goal.y) > 0.3
@@ -497,8 +498,7 @@ def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(t
     clock = Clock()
     ctx = _ctx(clock)
     ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0)])
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - VerifyTarget: {defer_s: 30}\n"), ctx)
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30}")
     assert tree.tick() == S.RUNNING
     ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "sofa", 5.0, 5.0)])
     assert tree.tick() == S.FAILURE
@@ -539,8 +539,7 @@ def test_verify_does_not_count_hidden_frames_and_moves_to_a_cell_that_sees(tmp_p
     chair = type(chair)(9, "chair", chair.center, np.array([4.0, 4.8, 0.0]), np.array([4.3, 5.2, 1.0]))
     objects = [obj(3, "bed", 5.0, 5.0), chair]
     ctx.world = world(pose, objects, anchors=[anchor(1, pose, (3,))])
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - VerifyTarget: {max_view_frames: 3, reposition_after: 4}\n"), ctx)
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {max_view_frames: 3, reposition_after: 4}")
     assert tree.tick() == S.RUNNING
     first = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
     ctx.nav = NavStatus(first.seq, "reached", 0.0)
@@ -606,8 +605,7 @@ def test_verify_defers_a_candidate_it_gets_no_nearer_to(tmp_path):
     clock = Clock()
     ctx = _ctx(clock)
     ctx.world = world(Pose2D(1.0, 1.0, 0.0), [obj(3, "bed", 8.0, 8.0)])
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - VerifyTarget: {}\n"), ctx)
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {}")
     assert tree.tick() == S.RUNNING
     for k in range(1, 8):
         clock.t = float(k)
@@ -619,14 +617,8 @@ def test_verify_defers_a_candidate_it_gets_no_nearer_to(tmp_path):
 def test_approach_goes_to_its_cell_even_when_it_starts_within_the_distance(tmp_path):
     """Approach starting 0.7 m off the bed's side, facing it, still goes to its approach cell
     (it stopped where VerifyTarget had left it, off a painting's end, in val/65/2)."""
-    clock = Clock()
-    ctx = _ctx(clock)
     start = Pose2D(3.8, 4.9, math.atan2(0.1, 1.2))
-    ctx.world = world(start, [obj(3, "bed", 5.0, 5.0)])
-    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    children:\n      - TargetConfirmed: {}\n"
-                                        "      - Approach: {distance: 0.8}\n"), ctx)
-    assert tree.tick() == S.RUNNING
-    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    _, _, goal = _approach_bed(tmp_path, start)
     assert goal.kind == "approach" and math.hypot(goal.x - start.x, goal.y - start.y) > 0.3
 
 
