@@ -639,3 +639,23 @@ def test_wall_clear_sees_past_known_furniture_but_not_past_walls():
     assert clear.tolist() == [False, True, False]  # behind the wall; same side; behind the wall
     assert wall_clear(grid, np.array([[2.0, 5.0]]), np.array([4.0, 5.0]), [table]).tolist() == [True]
     assert wall_clear(grid, np.array([[2.0, 5.0]]), np.array([4.0, 5.0]), []).tolist() == [False]
+
+
+def test_verify_out_of_range_after_the_box_moved_goes_to_a_new_cell_instead_of_glancing(tmp_path):
+    """The candidate's box moves as it is seen: at a cell chosen for the old box, now out of
+    range, the robot goes to a cell for the current box rather than glance from afar (val/31/2
+    glanced 364 steps 1.8 m from a real fridge, counting nothing)."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    pose = FACING_BED
+    ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0)], anchors=[anchor(1, pose, (3,))])
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {}")
+    assert tree.tick() == S.RUNNING
+    ctx.nav = NavStatus([m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].seq, "reached", 0.0)
+    tree.tick()  # close: a glance
+    assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.kind == "look"
+    ctx.nav = NavStatus([m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].seq, "reached", 0.0)
+    ctx.world = world(pose, [obj(3, "bed", 7.5, 7.5)], anchors=[anchor(2, pose)])  # the box moved away
+    tree.tick()
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert goal.kind == "approach" and math.hypot(goal.x - 7.5, goal.y - 7.5) < 2.0

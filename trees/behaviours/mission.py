@@ -525,7 +525,7 @@ class VerifyTarget(_GoToObject):
         self._seq = None
         self._excluded: list[np.ndarray] = []
         self._cand: Candidate | None = self.read("target")
-        self._close = False  # the robot has come within verify_distance (+0.25 m) of the candidate
+        self._close = False  # the robot is within _close_distance of the candidate (this tick)
         self._last_anchor: int | None = None  # the newest memory anchor already judged
         self._fresh = 0  # anchors in view that observed the candidate
         self._in_view = 0  # anchors (keyframes) with the candidate in the field of view
@@ -694,8 +694,12 @@ class VerifyTarget(_GoToObject):
         box_min, box_max = np.asarray(obj.box_min), np.asarray(obj.box_max)
         current = Candidate(cand.object_id, str(obj.label), np.asarray(obj.center, dtype=np.float64), box_min,
                             box_max, float(obj.confidence), int(obj.n_obs), cand.source)
-        if ctx.distance_to_box(box_min, box_max) <= self._close_distance(current):
-            self._close = True
+        # judged every tick: the candidate's box grows as it is seen; a robot that reached a
+        # view cell chosen for an older, smaller box may be out of range now, and glancing from
+        # there counted nothing until the episode ended (val/31/2: 364 steps of glances 1.8 m
+        # from a real fridge); out of range, it goes to a cell for the current box instead
+        self._close = ctx.distance_to_box(box_min, box_max) <= self._close_distance(current)
+        if self._close:
             self._count_frames(current)
             fresh, frames = self._fresh, self._in_view
             if fresh >= self.param("min_fresh_views") and fresh >= self.param("min_detection_rate") * frames:
