@@ -465,7 +465,7 @@ def test_approach_cell_prefers_the_front_of_an_objects_middle_over_its_near_end(
     """A painting 1 m long on a wall at x = 5: the plain nearest cell lies off its lower end (a
     grazing view, not a ground-truth view point); with the centre weight the cell faces its middle."""
     import numpy as np
-    from hiconav.trees.behaviours.mission import approach_cell
+    from hiconav.trees.behaviours.viewing import approach_cell
 
     from .fakes import open_grid
 
@@ -514,7 +514,7 @@ def test_anchor_sees_needs_the_point_in_the_image_and_no_box_in_the_way():
     """A tv 1.9 m up is above the vertical field of view of a camera 0.88 m up and 1 m away; a
     vase behind a chair is hidden; from 3 m away the tv is in view."""
     import numpy as np
-    from hiconav.trees.behaviours.mission import anchor_sees
+    from hiconav.trees.behaviours.viewing import anchor_sees
 
     cam = anchor(1, Pose2D(0.0, 0.0, 0.0), height=0.88)
     assert anchor_sees(cam, np.array([2.0, 0.0, 0.9]))
@@ -554,7 +554,7 @@ def test_verify_does_not_count_hidden_frames_and_moves_to_a_cell_that_sees(tmp_p
     moved = [g for g in goals if g.kind == "approach"]
     assert moved, goals
     g = moved[-1]
-    from hiconav.trees.behaviours.mission import segments_blocked
+    from hiconav.trees.behaviours.viewing import segments_blocked
 
     assert not segments_blocked(np.array([[g.x, g.y, 0.4]]), np.array([5.0, 5.0, 0.4]),
                                 chair.box_min[None, :] + [0.05, 0.05, 0.0], chair.box_max[None, :] - [0.05, 0.05, 0.0])[0]
@@ -625,7 +625,7 @@ def test_approach_goes_to_its_cell_even_when_it_starts_within_the_distance(tmp_p
 def test_wall_clear_sees_past_known_furniture_but_not_past_walls():
     """The 2D line of sight from an approach cell: occupied cells inside memory objects' boxes
     (a table) are see-through, the rest (a wall) are not."""
-    from hiconav.trees.behaviours.mission import wall_clear
+    from hiconav.trees.behaviours.viewing import wall_clear
 
     from .fakes import open_grid
 

@@ -14,8 +14,8 @@ from hiconav.trees.behaviours.mission import (
                                               Stop,
                                               TargetConfirmed,
                                               VerifyTarget,
-                                              approach_cell,
 )
+from hiconav.trees.behaviours.viewing import approach_cell
 
 __all__ = [
                                               "Approach",
