@@ -77,14 +77,13 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
         return None
     if tight and np.any(ok & roomy[r0:r1, c0:c1]):
         ok &= roomy[r0:r1, c0:c1]
+    centre = 0.5 * (np.asarray(box_min, dtype=np.float64)[:2] + np.asarray(box_max, dtype=np.float64)[:2])
     if furniture is not None:
         idx = np.flatnonzero(ok)
-        cells_xy = np.stack([x.flat[idx], y.flat[idx]], axis=1)
-        centre = 0.5 * (np.asarray(box_min, dtype=np.float64)[:2] + np.asarray(box_max, dtype=np.float64)[:2])
-        clear = wall_clear(grid, cells_xy, centre, [(box_min, box_max), *furniture])
+        clear = wall_clear(grid, np.stack([x.flat[idx], y.flat[idx]], axis=1), centre,
+                           [(box_min, box_max), *furniture])
         if clear.any() or strict_walls:
-            ok = np.zeros_like(ok)
-            ok.flat[idx[clear]] = True
+            ok = _only(ok, idx[clear])
         if not ok.any():
             return None
     if sight is not None:
@@ -93,17 +92,22 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
         starts = np.stack([x.flat[idx], y.flat[idx], np.full(idx.size, float(height))], axis=1)
         clear = ~segments_blocked(starts, point, lo, hi)
         if clear.any():
-            ok = np.zeros_like(ok)
-            ok.flat[idx[clear]] = True
+            ok = _only(ok, idx[clear])
     cost = np.hypot(x - robot_xy[0], y - robot_xy[1])
     if centre_weight > 0.0:
-        cx, cy = 0.5 * (box_min[0] + box_max[0]), 0.5 * (box_min[1] + box_max[1])
-        cost = cost + centre_weight * np.hypot(x - cx, y - cy)
+        cost = cost + centre_weight * np.hypot(x - centre[0], y - centre[1])
     if prefer_xy is not None and prefer_weight > 0.0:
         cost = cost + prefer_weight * np.hypot(x - prefer_xy[0], y - prefer_xy[1])
     cost = np.where(ok, cost, np.inf)
     i = int(np.argmin(cost))
     return np.array([x.flat[i], y.flat[i]])
+
+
+def _only(mask: np.ndarray, flat_idx: np.ndarray) -> np.ndarray:
+    """A mask of ``mask``'s shape that is True at the flat indices ``flat_idx`` alone."""
+    out = np.zeros_like(mask)
+    out.flat[flat_idx] = True
+    return out
 
 
 def facing(xy: np.ndarray, center: np.ndarray) -> float:
