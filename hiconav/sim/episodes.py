@@ -20,6 +20,7 @@ import numpy as np
 from hiconav.errors import DataError
 from hiconav.sim.geodesic import GoalDistance, house_graph
 from hiconav.sim.house import House
+from hiconav.sim.viewpoints import MIN_VIEW_PIXELS, viewable_instances
 from hiconav.types import Pose2D
 
 # Categories a user would ask for (Habitat's six first, then ProcTHOR furniture/appliances).
@@ -69,7 +70,8 @@ def _resolve(house: House | str) -> House:
 
 def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: float = 0.18,
                       min_distance: float = 1.5, max_distance: float = 30.0,
-                      categories: tuple[str, ...] | None = None) -> list[Episode]:
+                      categories: tuple[str, ...] | None = None,
+                      min_view_pixels: int | None = MIN_VIEW_PIXELS) -> list[Episode]:
     """``n`` episodes in ``house``; deterministic for a given (house, n, seed).
 
     The target is drawn uniformly among the categories in ``categories`` (default
@@ -77,6 +79,12 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
     ``TARGET_CATEGORIES``) that are present and reachable; the start is a uniformly drawn free
     cell whose geodesic distance to the target lies in [min_distance, max_distance], with a
     uniform yaw. Raises ``DataError`` if the house has no reachable target category.
+
+    Goal instances are only those a camera sees: at least ``min_view_pixels`` pixels in a view
+    from one of their view points (``viewpoints.viewable_instances``, as Habitat's ObjectNav
+    keeps only goals with view points). An object drawn inside its receptacle's box shows in no
+    pixel from anywhere; a category whose every instance is hidden is not drawn. ``None`` skips
+    the check (every instance is a goal, as before the check existed).
     """
     house = _resolve(house)
     allowed = categories or (GIBSON_GOAL_CATEGORIES if house.name.startswith("gibson:")
@@ -86,17 +94,31 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
     fields: dict[str, tuple[GoalDistance, np.ndarray]] = {}
     usable: list[str] = []
     graph = house_graph(house, radius)
-    for cat in present:
-        ids = tuple(o.instance_id for o in house.instances_of(cat))
-        gd = GoalDistance(house, instance_ids=ids, radius=radius)
-        ok = graph.mask & np.isfinite(gd.field) & (gd.field >= min_distance) & \
-            (gd.field <= max_distance)
-        cells = np.argwhere(ok)
-        if len(cells):
-            fields[cat] = (gd, cells)
-            usable.append(cat)
+    sim = None
+    if min_view_pixels is not None:
+        from hiconav.sim.simulator import Simulator
+
+        sim = Simulator(house)
+    try:
+        for cat in present:
+            ids = tuple(o.instance_id for o in house.instances_of(cat))
+            if sim is not None:
+                ids = viewable_instances(house, ids, sim, min_pixels=min_view_pixels)
+                if not ids:
+                    continue
+            gd = GoalDistance(house, instance_ids=ids, radius=radius)
+            ok = graph.mask & np.isfinite(gd.field) & (gd.field >= min_distance) & \
+                (gd.field <= max_distance)
+            cells = np.argwhere(ok)
+            if len(cells):
+                fields[cat] = (gd, cells)
+                usable.append(cat)
+    finally:
+        if sim is not None:
+            sim.close()
     if not usable:
-        raise DataError(f"{house.name} has no reachable target category (present: "
+        raise DataError(f"{house.name} has no reachable target category that a camera can see "
+                        f"(present: "
                         f"{', '.join(sorted(house.categories)) or 'none'})", field="target")
     episodes = []
     for i in range(n):
