@@ -68,6 +68,10 @@ class MissionContext:
     nav: NavStatus | None = None
     rejected: set[int] = field(default_factory=set)  # object ids that failed verification for good
     deferred: dict[int, float] = field(default_factory=dict)  # object id -> clock time it may be tried again
+    # object id -> its observation count when deferred: a deferred candidate that the detector has
+    # since seen ``requalify_observations`` more times under a target label is due at once
+    deferred_obs: dict[int, int] = field(default_factory=dict)
+    requalify_observations: int = 3  # 0: never (a deferral lasts its time)
     rejections: list[tuple[int, str]] = field(default_factory=list)  # every rejection/deferral, in order
     start_pose: Pose2D | None = None
     outbox: list[Any] = field(default_factory=list)
@@ -129,15 +133,38 @@ class MissionContext:
         return self.nav.state
 
     def excluded(self, object_id: int) -> bool:
-        """True while a candidate is rejected or deferred."""
-        return object_id in self.rejected or self.deferred.get(object_id, -1.0) > self.now()
+        """True while a candidate is rejected or deferred.
 
-    def reject(self, object_id: int, reason: str, *, permanent: bool = True, defer_s: float = 30.0) -> None:
-        """Verification failed: exclude the candidate for good, or for ``defer_s`` clock seconds."""
+        A deferral made with ``requalify`` lapses early once the node has gained
+        ``requalify_observations`` observations and carries a target label again: a label flip
+        deferred a real armchair for 30 s of a 50 s episode while the detector went on reading it
+        as an armchair (val/6/1). Only label flips requalify: an unreachable or unconfirmed
+        candidate is observed again at once from where the robot stands."""
+        if object_id in self.rejected:
+            return True
+        if self.deferred.get(object_id, -1.0) <= self.now():
+            return False
+        base = self.deferred_obs.get(object_id)
+        obj = self.object(object_id) if base is not None and self.task is not None and self.requalify_observations else None
+        if obj is not None and obj.label in self.task.targets and int(obj.n_obs) >= base + self.requalify_observations:
+            self.log(f"deferral of #{object_id} lapsed: {int(obj.n_obs) - base} new observations as {obj.label!r}")
+            del self.deferred[object_id]
+            return False
+        return True
+
+    def reject(self, object_id: int, reason: str, *, permanent: bool = True, defer_s: float = 30.0,
+               requalify: bool = False) -> None:
+        """Verification failed: exclude the candidate for good, or for ``defer_s`` clock seconds
+        (with ``requalify``, or until it is observed again as a target: see ``excluded``)."""
         if permanent:
             self.rejected.add(object_id)
         else:
             self.deferred[object_id] = self.now() + defer_s
+            obj = self.object(object_id) if requalify else None
+            if obj is not None:
+                self.deferred_obs[object_id] = int(obj.n_obs)
+            else:
+                self.deferred_obs.pop(object_id, None)
         self.rejections.append((object_id, reason))
         self.log(f"{'rejected' if permanent else 'deferred'} #{object_id}: {reason}")
 

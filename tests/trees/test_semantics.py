@@ -510,6 +510,37 @@ def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(t
     assert [c.object_id for c in ctx.candidates()] == [3]
 
 
+def test_a_label_flip_deferral_lapses_once_the_node_is_seen_again_as_the_target(tmp_path):
+    """val/6/1: a real armchair read as 'sofa' for a while was deferred for 30 s of a 50 s
+    episode while the detector went on reading it as an armchair; three new observations under
+    a target label bring it back at once (and not fewer, and not under another label)."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=5)])
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30}")
+    assert tree.tick() == S.RUNNING
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "sofa", 5.0, 5.0, n_obs=6)])
+    assert tree.tick() == S.FAILURE
+    clock.t = 2.0
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "sofa", 5.0, 5.0, n_obs=12)])
+    assert ctx.excluded(3)  # seen again, but as a sofa
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=8)])
+    assert ctx.excluded(3)  # a bed again, but only two observations since
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=9)])
+    assert not ctx.excluded(3) and [c.object_id for c in ctx.candidates()] == [3]
+
+
+def test_an_unreachable_deferral_does_not_lapse_on_new_observations():
+    """Approach defers an unreachable candidate that the robot keeps seeing from where it stands:
+    re-qualifying on observations would loop between approach and deferral."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=5)])
+    ctx.reject(3, "approach: no reachable cell", permanent=False, defer_s=30.0)
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=50)])
+    assert ctx.excluded(3)
+
+
 def test_anchor_sees_needs_the_point_in_the_image_and_no_box_in_the_way():
     """A tv 1.9 m up is above the vertical field of view of a camera 0.88 m up and 1 m away; a
     vase behind a chair is hidden; from 3 m away the tv is in view."""
@@ -659,3 +690,15 @@ def test_verify_out_of_range_after_the_box_moved_goes_to_a_new_cell_instead_of_g
     tree.tick()
     goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
     assert goal.kind == "approach" and math.hypot(goal.x - 7.5, goal.y - 7.5) < 2.0
+
+
+def test_requalify_observations_zero_keeps_a_label_flip_deferred_for_its_time():
+    """mission.requalify_observations = 0 (the setting's off switch) restores plain deferrals."""
+    clock = Clock()
+    ctx = _ctx(clock, requalify_observations=0)
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=5)])
+    ctx.reject(3, "label is now 'sofa'", permanent=False, defer_s=30.0, requalify=True)
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=50)])
+    assert ctx.excluded(3)
+    clock.t = 31.0
+    assert not ctx.excluded(3)

@@ -497,13 +497,13 @@ class VerifyTarget(_GoToObject):
         return {int(o.id) for o in self.context.memory.objects if o.label in labels
                 and np.all(np.asarray(o.box_min)[:2] <= hi) and np.all(np.asarray(o.box_max)[:2] >= lo)}
 
-    def _reject(self, why: str, permanent: bool) -> Status:
+    def _reject(self, why: str, permanent: bool, requalify: bool = False) -> Status:
         cand = self._cand
         if cand is not None:
             ctx = self.context
             count = sum(1 for oid, _ in ctx.rejections if oid == cand.object_id) + 1
             ctx.reject(cand.object_id, why, permanent=permanent or count >= self.param("max_deferrals"),
-                       defer_s=self.param("defer_s"))
+                       defer_s=self.param("defer_s"), requalify=requalify)
         self.feedback_message = f"{'rejected' if permanent else 'deferred'}: {why}"
         return Status.FAILURE
 
@@ -523,7 +523,7 @@ class VerifyTarget(_GoToObject):
             # deferred, not rejected: a node's label is a vote over its observations and flips
             # back and forth between confusable labels (a real fridge read as 'cabinet' for a
             # while was rejected for good in val/1/2, and the robot explored out the house)
-            return self._reject(f"label is now {obj.label!r}", False)
+            return self._reject(f"label is now {obj.label!r}", False, requalify=True)
         box_min, box_max = np.asarray(obj.box_min), np.asarray(obj.box_max)
         current = Candidate(cand.object_id, str(obj.label), np.asarray(obj.center, dtype=np.float64), box_min,
                             box_max, float(obj.confidence), int(obj.n_obs), cand.source)
