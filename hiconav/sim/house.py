@@ -264,10 +264,13 @@ def rect_mask(nav_shape: tuple[int, int], origin: np.ndarray, res: float, center
 def box_footprint_cells(nav: NavGrid, obj: SimObject) -> np.ndarray:
     """(N, 2) int cells (row, col) whose centre lies in the object's footprint.
 
-    Objects thinner than a cell still get the cell that contains their centre.
+    Each side counts as at least one cell wide: a painting 3 cm thick and 94 cm long lies between
+    two columns of cell centres, and its footprint was the one cell at its middle, so a robot
+    0.57 m from the painting's end stood 1.02 m from its "footprint" and failed (val/65/2).
+    Objects smaller than a cell both ways still get the cell that contains their centre.
     """
-    rs, cs, mask = rect_mask(nav.shape, nav.origin, nav.resolution, obj.center, obj.size,
-                             obj.yaw)
+    size = np.maximum(np.asarray(obj.size[:2], dtype=np.float64), nav.resolution * (1.0 + 1e-6))
+    rs, cs, mask = rect_mask(nav.shape, nav.origin, nav.resolution, obj.center, size, obj.yaw)
     rr, cc = np.nonzero(mask)
     cells = np.stack([rr + (rs.start or 0), cc + (cs.start or 0)], axis=1).astype(np.int64)
     if len(cells) == 0:

@@ -151,3 +151,14 @@ def test_an_object_that_no_view_point_reaches_within_a_metre_can_still_be_found(
     assert len(cells) and offsets.min() <= VIEW_RADIUS
     gd = GoalDistance(house, instance_ids=[0])
     assert gd.distance(np.array([4.0, 5.5])) <= 1.0  # beside the cabinet, 1.25 m from the toilet
+
+
+@pytest.mark.parametrize("x", [2.0, 2.0125, 2.025, 2.04])  # any phase against the 5 cm cells
+def test_a_thin_wall_object_has_a_footprint_along_its_whole_length(x):
+    """val/65/2: a painting 3 cm thick lay between two columns of cell centres and its footprint
+    was the single cell at its middle, so a robot 0.57 m from its end was 1.02 m "away"."""
+    house = box_room(6.0, [obj(0, "painting", (x, 3.0, 1.5), (0.03, 0.9, 0.6))])
+    xy = house.nav.cell_to_world(house.footprint(0))
+    assert xy[:, 1].min() < 2.6 and xy[:, 1].max() > 3.4
+    d = GoalDistance(house, instance_ids=(0,)).distance(np.array([x - 0.4, 2.2]))
+    assert d == pytest.approx(math.hypot(0.4, 0.35), abs=0.08)
