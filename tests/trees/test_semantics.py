@@ -480,6 +480,31 @@ def test_approach_cell_prefers_the_front_of_an_objects_middle_over_its_near_end(
     assert abs(centred[1] - 4.5) < 0.45 and centred[0] > 4.1  # in front of the middle, within 0.8 m
 
 
+def test_approach_cell_on_a_settle_ring_is_the_one_nearest_the_object():
+    """Gibson: with no free cell within 0.8 m the robot settled on the 1 m ring at the cell nearest
+    to itself, 0.96-1.06 m from the box, where the box's error decides success; with the box
+    weight it takes the nearest free cell to the object (here 0.85 m out)."""
+    import numpy as np
+    from hiconav.trees.behaviours.viewing import approach_cell
+
+    from .fakes import open_grid
+
+    grid = open_grid()
+    lo, hi = np.array([5.0, 5.0, 0.0]), np.array([5.5, 5.5, 0.9])
+    # clutter round the object: the map has no free cell within 0.8 m of its box
+    rows, cols = np.mgrid[0:100, 0:100]
+    x, y = (cols + 0.5) * 0.1, (rows + 0.5) * 0.1
+    dist = np.hypot(np.maximum(np.maximum(lo[0] - x, 0), x - hi[0]), np.maximum(np.maximum(lo[1] - y, 0), y - hi[1]))
+    grid.inflated[dist <= 0.8] = True
+    robot = np.array([2.0, 5.2])
+    assert approach_cell(grid, lo, hi, robot, 0.8) is None
+    plain = approach_cell(grid, lo, hi, robot, 1.0)
+    near = approach_cell(grid, lo, hi, robot, 1.0, box_weight=4.0)
+    d = lambda c: float(np.hypot(max(lo[0] - c[0], 0, c[0] - hi[0]), max(lo[1] - c[1], 0, c[1] - hi[1])))
+    assert d(plain) > 0.9  # the ring's edge, toward the robot
+    assert d(near) < 0.87
+
+
 def test_approach_is_not_done_on_passing_within_the_distance_off_the_target(tmp_path):
     """Done at the approach cell, not at the first point within the distance of the footprint."""
     ctx, tree, goal = _approach_bed(tmp_path, Pose2D(1.5, 1.5, 0.0))

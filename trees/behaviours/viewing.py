@@ -20,7 +20,7 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
                   tight: bool = False, centre_weight: float = 0.0, prefer_xy: np.ndarray | None = None,
                   prefer_weight: float = 0.0, sight: tuple[np.ndarray, float, np.ndarray, np.ndarray] | None = None,
                   furniture: list[tuple[np.ndarray, np.ndarray]] | None = None,
-                  strict_walls: bool = False) -> np.ndarray | None:
+                  strict_walls: bool = False, box_weight: float = 0.0) -> np.ndarray | None:
     """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint.
 
     grid: snapshot with ``state`` (H, W) int8 (0 free), ``inflated`` (H, W) bool, ``origin`` (2,),
@@ -40,7 +40,10 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     hi) boxes): when some candidate cells see the footprint's centre on the 2D map past every
     occupied cell that no memory object (nor the target) explains, that is past walls
     (``wall_clear``), only those are kept; with ``strict_walls`` the others never are (None
-    when every cell is behind a wall).
+    when every cell is behind a wall). ``box_weight`` adds that many times the cell's distance to
+    the footprint: for a ring wider than the success distance the nearest cell to the robot lies
+    on the ring's edge, 1 m out, where the object's box error decides success (Gibson stopped
+    0.96-1.06 m from five targets' boxes while free cells 0.1-0.2 m nearer were known).
     """
     from scipy import ndimage
 
@@ -94,6 +97,8 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
         if clear.any():
             ok = _only(ok, idx[clear])
     cost = np.hypot(x - robot_xy[0], y - robot_xy[1])
+    if box_weight > 0.0:
+        cost = cost + box_weight * np.hypot(dx, dy)
     if centre_weight > 0.0:
         cost = cost + centre_weight * np.hypot(x - centre[0], y - centre[1])
     if prefer_xy is not None and prefer_weight > 0.0:
