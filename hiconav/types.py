@@ -179,6 +179,9 @@ class Goal:
     tolerance: float = 0.25
     kind: str = "frontier"  # "frontier" | "object" | "approach"
     ref_id: int | None = None  # frontier id or object node id
+    # the path may cross unknown cells: the last short creep toward an object whose nearby floor
+    # the camera never saw (it sees no floor nearer than ~1.4 m; see ``Approach``)
+    through_unknown: bool = False
 
     @property
     def xy(self) -> np.ndarray:

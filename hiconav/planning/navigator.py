@@ -129,7 +129,8 @@ class Navigator:
     # ------------------------------------------------------------------ planning
     def _blocked(self, grid: GridLike, start_rc: np.ndarray, tight: bool = False) -> np.ndarray:
         cfg = self.config
-        blocked = blocked_cells(grid, through_unknown=cfg.plan_through_unknown, tight=tight)
+        through_unknown = cfg.plan_through_unknown or (self.goal is not None and self.goal.through_unknown)
+        blocked = blocked_cells(grid, through_unknown=through_unknown, tight=tight)
         res = grid.resolution
         for x, y, r in self._virtual:
             rc = grid.world_to_cell(np.array([x, y]))

@@ -127,6 +127,18 @@ def test_unreachable_goal_stops_with_no_path():
     assert nav.step(snapshot(s), Pose2D(1.0, 2.5, 0.0)) == DiscreteAction.STOP and nav.status == "idle"
 
 
+def test_a_goal_may_ask_for_a_path_through_unknown_cells():
+    """Approach's last creep toward an object crosses floor the camera never saw; other goals do not."""
+    s = open_room()
+    s[:, 45:55] = -1  # a band never seen
+    plain = Navigator()
+    plain.set_goal(Goal(4.0, 2.5))
+    assert plain.step(snapshot(s), Pose2D(1.0, 2.5, 0.0)) == DiscreteAction.STOP and plain.status == "no_path"
+    creep = Navigator()
+    creep.set_goal(Goal(4.0, 2.5, through_unknown=True))
+    assert creep.step(snapshot(s), Pose2D(1.0, 2.5, 0.0)) == DiscreteAction.MOVE_FORWARD
+
+
 def test_replans_when_the_path_becomes_blocked():
     grid = snapshot(open_room())
     nav = Navigator()

@@ -517,6 +517,35 @@ def test_approach_is_not_done_on_passing_within_the_distance_off_the_target(tmp_
     assert tree.tick() == S.SUCCESS
 
 
+def test_approach_settled_beyond_its_distance_creeps_through_unknown_floor_then_stops(tmp_path):
+    """The camera sees no floor within ~1.4 m, so the floor by an object is often unknown and the
+    robot settled 0.96 m from a plant's box (Gibson Ranchester/0/1); it creeps toward the box
+    through the unknown cells, then faces it and stops."""
+    import numpy as np
+
+    from .fakes import open_grid
+
+    grid = open_grid()
+    rows, cols = np.mgrid[0:100, 0:100]
+    x, y = (cols + 0.5) * 0.1, (rows + 0.5) * 0.1
+    gap = np.hypot(np.maximum(np.maximum(4.5 - x, 0), x - 5.5), np.maximum(np.maximum(4.5 - y, 0), y - 5.5))
+    grid.state[(gap > 0) & (gap <= 0.85)] = -1  # never seen: no approach cell within 0.8 m
+    ctx = _ctx(Clock())
+    ctx.world = world(Pose2D(2.0, 5.0, 0.0), [obj(3, "bed", 5.0, 5.0)], grid=grid)
+    tree = _confirmed_then(tmp_path, ctx, "Approach: {distance: 0.8}")
+    assert tree.tick() == S.RUNNING
+    settle = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert not settle.through_unknown and 0.8 < 4.5 - settle.x <= 1.0
+    ctx.world = world(Pose2D(settle.x, settle.y, 0.0), [obj(3, "bed", 5.0, 5.0)], grid=grid)
+    assert tree.tick() == S.RUNNING  # not done: it creeps first
+    creep = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    assert creep.goal.through_unknown and 4.5 - creep.goal.x == pytest.approx(0.8, abs=0.03)
+    ctx.world = world(Pose2D(creep.goal.x, creep.goal.y, 0.0), [obj(3, "bed", 5.0, 5.0)], grid=grid)
+    ctx.nav = NavStatus(creep.seq, "reached", 0.0)
+    assert tree.tick() == S.RUNNING  # faces the object where it stands
+    assert tree.tick() == S.SUCCESS
+
+
 def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(tmp_path):
     """A node's label is a vote: a real fridge read as 'cabinet' for a while came back as a
     fridge, but a permanent rejection had already made the robot explore the house out."""
