@@ -207,6 +207,24 @@ def test_verify_rejects_a_candidate_rarely_detected_while_in_view(tmp_path):
     assert 3 in ctx.rejected
 
 
+def test_verify_does_not_count_frames_with_a_wall_between_camera_and_candidate(tmp_path):
+    """Gibson Wainscott/0/2: a real plant behind a corner of a scanned wall was rejected as
+    "detected in 0 of 8 frames in view"; a wall on the map (an occupied cell no memory object
+    explains) between the camera and the candidate hides it like a memory object does."""
+    from .fakes import open_grid
+
+    walled = open_grid()
+    walled.state[38:46, 42] = 1  # a wall stub across the line from (4, 4) to the bed at (5, 5)
+    for grid, rejected in ((open_grid(), True), (walled, False)):
+        ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 4, reposition_after: 100")
+        tree.tick()
+        for aid in range(2, 8):
+            ctx.world = world(FACING_BED, [obj(3, "bed", 5.0, 5.0)], grid=grid, anchors=[anchor(aid, FACING_BED)])
+            status = tree.tick()
+        assert (status == S.FAILURE) == rejected
+        assert any("0 of 4 frames" in why for _, why in ctx.rejections) == rejected
+
+
 def test_verify_counts_only_frames_with_the_candidate_in_view(tmp_path):
     away = Pose2D(4.0, 4.0, math.pi)  # the bed is behind the robot
     ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 5", away)
