@@ -50,6 +50,24 @@ def _cached_specs(out: Path, source: dict[str, Any]) -> list[Any] | None:
     return read_specs(out / SPECS_FILE)
 
 
+def _check_resumable(out: Path, source: dict[str, Any]) -> None:
+    """Refuse an output folder whose results come from other source options: resuming skips
+    episodes by id, so the old records would stand for episodes that are no longer the same
+    (a seed, a limit, or the episode rules of an older version)."""
+    try:
+        saved = json.loads((out / SOURCE_FILE).read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError):
+        return
+    records = out / "episodes.jsonl"
+    # --limit only takes the first episodes of the same list: a run may be extended
+    changed = sorted(k for k in set(saved) | set(source) if k != "limit" and saved.get(k) != source.get(k))
+    if not changed or not records.exists() or records.stat().st_size == 0:
+        return
+    raise DataError(f"{out} holds results for other episode options ({', '.join(changed)}: "
+                    f"{[saved.get(k) for k in changed]} there, {[source.get(k) for k in changed]} now); "
+                    "use another --out, or delete the folder", field="--out")
+
+
 def _save_specs(out: Path, source: dict[str, Any], specs: list[Any]) -> None:
     from hiconav.eval.sources import write_specs
 
@@ -98,10 +116,14 @@ def eval(
                         workers=workers, backend=backend, address=address, stuck_window=stuck_window,
                         progress=progress)
     n_workers = workers if workers is not None else (os.cpu_count() or 1)
+    from hiconav.sim.episodes import EPISODE_RULES
+
     source = {"houses": str(Path(houses).resolve()) if houses else None,
               "maps": str(Path(maps).resolve()) if maps else None,
               "episodes": [str(Path(p).resolve()) for p in episodes or []],
-              "episodes_per_house": episodes_per_house, "seed": seed, "limit": limit}
+              "episodes_per_house": episodes_per_house, "seed": seed, "limit": limit,
+              "episode_rules": None if episodes else EPISODE_RULES}
+    _check_resumable(Path(out), source)
     specs = _cached_specs(Path(out), source)
     if specs is None:
         if houses is not None:

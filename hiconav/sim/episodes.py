@@ -33,6 +33,11 @@ TARGET_CATEGORIES: tuple[str, ...] = (
 )
 
 
+# What decides a generated episode besides (house, n, seed); an eval output folder records it, so
+# that results of episodes generated under other rules are never resumed as if they were these.
+EPISODE_RULES = "goals: instances with >= 150 px from a view point; footprints at least one cell wide"
+
+
 # Gibson ObjectNav v1.1 uses only these six goal categories (data README).
 GIBSON_GOAL_CATEGORIES: tuple[str, ...] = ("chair", "sofa", "plant", "bed", "toilet", "tv")
 
