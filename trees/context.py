@@ -145,7 +145,9 @@ class MissionContext:
         if self.deferred.get(object_id, -1.0) <= self.now():
             return False
         base = self.deferred_obs.get(object_id)
-        obj = self.object(object_id) if base is not None and self.task is not None and self.requalify_observations else None
+        if base is None or self.task is None or not self.requalify_observations:
+            return True
+        obj = self.object(object_id)
         if obj is not None and obj.label in self.task.targets and int(obj.n_obs) >= base + self.requalify_observations:
             self.log(f"deferral of #{object_id} lapsed: {int(obj.n_obs) - base} new observations as {obj.label!r}")
             del self.deferred[object_id]

@@ -36,30 +36,34 @@ SOURCE_FILE = "source.json"
 SPECS_FILE = "specs.jsonl"
 
 
-def _cached_specs(out: Path, source: dict[str, Any]) -> list[Any] | None:
-    """The episode specs saved by an earlier run into ``out`` from the same source options (so a
-    resumed run does not generate episodes again), or None."""
-    from hiconav.eval.sources import read_specs
-
+def _saved_source(out: Path) -> dict[str, Any] | None:
+    """The source options an earlier run saved into ``out`` (``source.json``), or None."""
     try:
-        saved = json.loads((out / SOURCE_FILE).read_text(encoding="utf-8"))
+        return json.loads((out / SOURCE_FILE).read_text(encoding="utf-8"))
     except (OSError, json.JSONDecodeError):
         return None
+
+
+def _cached_specs(out: Path, saved: dict[str, Any] | None, source: dict[str, Any]) -> list[Any] | None:
+    """The episode specs saved by an earlier run into ``out`` from the same source options
+    (``saved``: its ``source.json``), so a resumed run does not generate episodes again; or None."""
+    from hiconav.eval.sources import read_specs
+
     if saved != source or not (out / SPECS_FILE).exists():
         return None
     return read_specs(out / SPECS_FILE)
 
 
-def _check_resumable(out: Path, source: dict[str, Any]) -> None:
-    """Refuse an output folder whose results come from other source options: resuming skips
-    episodes by id, so the old records would stand for episodes that are no longer the same
-    (a seed, a limit, or the episode rules of an older version)."""
-    try:
-        saved = json.loads((out / SOURCE_FILE).read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError):
+def _check_resumable(out: Path, saved: dict[str, Any] | None, source: dict[str, Any]) -> None:
+    """Refuse an output folder whose results come from other source options (``saved``: its
+    ``source.json``): resuming skips episodes by id, so the old records would stand for episodes
+    that are no longer the same (another seed or input, or the episode rules of an older
+    version). A different ``--limit`` only takes more or fewer episodes of the same list."""
+    from hiconav.eval.runner import EPISODES_FILE
+
+    if saved is None:
         return
-    records = out / "episodes.jsonl"
-    # --limit only takes the first episodes of the same list: a run may be extended
+    records = out / EPISODES_FILE
     changed = sorted(k for k in set(saved) | set(source) if k != "limit" and saved.get(k) != source.get(k))
     if not changed or not records.exists() or records.stat().st_size == 0:
         return
@@ -123,8 +127,9 @@ def eval(
               "episodes": [str(Path(p).resolve()) for p in episodes or []],
               "episodes_per_house": episodes_per_house, "seed": seed, "limit": limit,
               "episode_rules": None if episodes else EPISODE_RULES}
-    _check_resumable(Path(out), source)
-    specs = _cached_specs(Path(out), source)
+    saved = _saved_source(Path(out))
+    _check_resumable(Path(out), saved, source)
+    specs = _cached_specs(Path(out), saved, source)
     if specs is None:
         if houses is not None:
             specs = procthor_source(houses, episodes_per_house, seed=seed, limit=limit, workers=n_workers)

@@ -123,8 +123,7 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
             sim.close()
     if not usable:
         raise DataError(f"{house.name} has no reachable target category that a camera can see "
-                        f"(present: "
-                        f"{', '.join(sorted(house.categories)) or 'none'})", field="target")
+                        f"(present: {', '.join(sorted(house.categories)) or 'none'})", field="target")
     episodes = []
     for i in range(n):
         cat = usable[int(rng.integers(len(usable)))]

@@ -98,19 +98,19 @@ def test_an_output_folder_with_results_from_other_episode_options_is_refused(tmp
     """Resuming skips episodes by id: records of episodes generated under other options (another
     seed, or an older version's episode rules) must not stand for the new ones."""
     from hiconav.errors import DataError
-    from hiconav.eval.cli import _check_resumable
+    from hiconav.eval.cli import _check_resumable, _saved_source
     from hiconav.sim.episodes import EPISODE_RULES
 
     source = {"houses": "/d/val.jsonl.gz", "maps": None, "episodes": [], "episodes_per_house": 3, "seed": 0,
               "limit": None, "episode_rules": EPISODE_RULES}
     old = {k: v for k, v in source.items() if k != "episode_rules"}  # written before the rules were recorded
     (tmp_path / "source.json").write_text(json.dumps(old))
-    _check_resumable(tmp_path, source)  # no results yet: the folder is simply reused
+    _check_resumable(tmp_path, _saved_source(tmp_path), source)  # no results yet: the folder is simply reused
     (tmp_path / "episodes.jsonl").write_text('{"episode_id": "x"}\n')
     with pytest.raises(DataError, match="episode_rules"):
-        _check_resumable(tmp_path, source)
+        _check_resumable(tmp_path, _saved_source(tmp_path), source)
     (tmp_path / "source.json").write_text(json.dumps({**source, "limit": 30}))
-    _check_resumable(tmp_path, source)  # a longer run over the same list extends it
+    _check_resumable(tmp_path, _saved_source(tmp_path), source)  # a longer run over the same list extends it
     (tmp_path / "source.json").write_text(json.dumps({**source, "seed": 1}))
     with pytest.raises(DataError, match="seed"):
-        _check_resumable(tmp_path, source)
+        _check_resumable(tmp_path, _saved_source(tmp_path), source)

@@ -245,6 +245,7 @@ class _GoToObject(MissionBehaviour):
     READS = ("target",)
     # approach_cell's weight on a cell's distance to the footprint's centre (see Approach)
     CENTRE_WEIGHT = 0.0
+
     def _prefer_weight(self) -> float:
         """approach_cell's weight on a cell's distance to ``_preferred_xy`` (see VerifyTarget)."""
         return 0.0
@@ -487,14 +488,13 @@ class VerifyTarget(_GoToObject):
         blockers = self._blockers(cand, support)
         fresh = sorted(fresh, key=lambda a: int(a.id))
         # a wall on the map between the camera and the candidate hides it too (an occupied cell no
-        # memory object explains): a real plant behind a corner of a scanned wall was rejected as
-        # "detected in 0 of 8 frames in view" (Gibson Wainscott/0/2)
+        # memory object explains; the candidate's own node is one of the memory's objects), as a
+        # memory object's box does
         grid = self.context.grid
         if grid is not None:
             cams = np.array([np.asarray(a.T_world_cam, dtype=np.float64)[:2, 3] for a in fresh])
             known = [(np.asarray(o.box_min), np.asarray(o.box_max)) for o in memory.objects]
-            walls_clear = wall_clear(grid, cams, np.asarray(cand.center, dtype=np.float64)[:2],
-                                     [(np.asarray(cand.box_min), np.asarray(cand.box_max)), *known])
+            walls_clear = wall_clear(grid, cams, np.asarray(cand.center, dtype=np.float64)[:2], known)
         else:
             walls_clear = np.ones(len(fresh), dtype=bool)
         for a, clear in zip(fresh, walls_clear):
