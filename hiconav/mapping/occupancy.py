@@ -117,7 +117,10 @@ class GridSnapshot(_OccupancyFields):
     dilated by the robot radius + inflation margin); lethal: (H, W) bool (dilated by the robot
     radius alone: the tight passages only a fallback plan may use; ``inflated`` when not given,
     i.e. no tight passages); explored: (H, W) bool (ever observed); origin: (2,) world xy
-    of the corner of cell (0, 0); resolution: m per cell; version: number of integrated frames.
+    of the corner of cell (0, 0); resolution: m per cell; version: number of integrated frames;
+    top: (H, W) float32 or None, metres above the floor of the highest obstacle point seen in
+    each cell since it was last seen free (0 where none; inf where the points reach the top of
+    the mapped band, as a wall's do; None: heights not kept).
     """
 
     state: np.ndarray
@@ -128,12 +131,14 @@ class GridSnapshot(_OccupancyFields):
     version: int
     stamp: float
     lethal: np.ndarray | None = None  # type: ignore[assignment]  # filled in __post_init__
+    top: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.lethal is None:
             object.__setattr__(self, "lethal", self.inflated)
-        for name in ("state", "inflated", "lethal", "explored", "origin"):
-            freeze(getattr(self, name))
+        for name in ("state", "inflated", "lethal", "explored", "origin", "top"):
+            if getattr(self, name) is not None:
+                freeze(getattr(self, name))
 
 
 
@@ -169,6 +174,9 @@ class OccupancyGrid(_OccupancyFields):
         self.inflated = np.zeros((0, 0), dtype=bool)
         self.lethal = np.zeros((0, 0), dtype=bool)
         self.explored = np.zeros((0, 0), dtype=bool)
+        # metres above the floor of the highest obstacle point in each cell since it was last seen
+        # free: the 2D map alone cannot tell a 0.8 m table, which a camera sees over, from a wall
+        self.top = np.zeros((0, 0), dtype=np.float32)
         self.version = 0
         self.stamp = 0.0
         self.n_invalid_total = 0
@@ -208,13 +216,15 @@ class OccupancyGrid(_OccupancyFields):
         nh = int(math.ceil((ny1 - oy) / res - 1e-9))
         logodds = np.zeros((nh, nw), dtype=np.int8)
         explored = np.zeros((nh, nw), dtype=bool)
+        top = np.zeros((nh, nw), dtype=np.float32)
         if h > 0:
             r0 = int(round((self.origin[1] - oy) / res))
             c0 = int(round((self.origin[0] - ox) / res))
             logodds[r0 : r0 + h, c0 : c0 + w] = self.logodds
             explored[r0 : r0 + h, c0 : c0 + w] = self.explored
+            top[r0 : r0 + h, c0 : c0 + w] = self.top
         self.origin = np.array([ox, oy], dtype=np.float64)
-        self.logodds, self.explored = logodds, explored
+        self.logodds, self.explored, self.top = logodds, explored, top
         self.state = np.where(explored, (logodds > 0).astype(np.int8), np.int8(UNKNOWN)).astype(np.int8)
         occ = (self.state == OCCUPIED).astype(np.uint8)
         self.inflated = cv2.dilate(occ, self._kernel).astype(bool)
@@ -270,7 +280,7 @@ class OccupancyGrid(_OccupancyFields):
 
         rel_z = pz - c.floor_z
         is_obs = (rel_z >= c.obstacle_min_height) & (rel_z <= c.obstacle_max_height)
-        obs_x, obs_y = px[is_obs], py[is_obs]
+        obs_x, obs_y, obs_z = px[is_obs], py[is_obs], rel_z[is_obs]
 
         # window touched by this frame: the mapping range around the camera
         reach = c.max_depth + 2 * res
@@ -362,6 +372,7 @@ class OccupancyGrid(_OccupancyFields):
         # each point marks the cells its (2 * obstacle_pad)-wide square touches, so that a surface
         # lying near a cell boundary marks the cells on both sides (grid-phase independent)
         hit = np.zeros((wh, ww), dtype=bool)
+        hit_top = np.zeros(wh * ww, dtype=np.float32)  # highest point marking each cell this frame
         if obs_x.shape[0]:
             pad = c.obstacle_pad * res
             shifts = (-pad, pad) if pad > 0 else (0.0,)
@@ -371,10 +382,16 @@ class OccupancyGrid(_OccupancyFields):
             col_ok = [(oc >= 0) & (oc < ww) for oc in cols]
             row_ok = [(orow >= 0) & (orow < wh) for orow in rows]
             flat = hit.reshape(-1)
+            marked, marked_z = [], []
             for oc, cok in zip(cols, col_ok):
                 for orow, rok in zip(rows, row_ok):
                     ok = cok & rok
                     flat[orow[ok] * ww + oc[ok]] = True
+                    marked.append(orow[ok] * ww + oc[ok])
+                    marked_z.append(obs_z[ok])
+            np.maximum.at(hit_top, np.concatenate(marked), np.concatenate(marked_z))
+            # points above the band are not mapped: a cell marked up to its top may go on up (a wall)
+            hit_top[hit_top >= c.obstacle_max_height - 2 * res] = np.inf
 
         # log-odds update (hits after misses so that a cell seen both ways leans occupied)
         lo = self.logodds[r0:r1, c0:c1].astype(np.int16)
@@ -393,6 +410,9 @@ class OccupancyGrid(_OccupancyFields):
                 sub[k] = np.minimum(sub[k], -1)
                 expl[fr0 : fr0 + k.shape[0], fc0 : fc0 + k.shape[1]] |= k
         self.logodds[r0:r1, c0:c1] = lo.astype(np.int8)
+        top = self.top[r0:r1, c0:c1]
+        top[free_mask & ~hit] = 0.0  # seen free: what stood there is gone
+        np.maximum(top, hit_top.reshape(wh, ww), out=top)
         self.state[r0:r1, c0:c1] = np.where(expl, (lo > 0).astype(np.int8), np.int8(UNKNOWN))
 
         # inflation of the touched region (dilate a margin larger by the kernel radius)
@@ -425,6 +445,7 @@ class OccupancyGrid(_OccupancyFields):
             inflated=self.inflated.copy(),
             lethal=self.lethal.copy(),
             explored=self.explored.copy(),
+            top=self.top.copy(),
             origin=self.origin.copy(),
             resolution=self.resolution,
             version=self.version,

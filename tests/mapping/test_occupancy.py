@@ -89,6 +89,26 @@ def test_box_on_the_floor_is_an_obstacle_with_unknown_shadow():
     assert cell_state(grid, 1.5, 0.0) == FREE
 
 
+def test_cells_keep_the_height_of_their_highest_obstacle_point():
+    """A 0.6 m box keeps its top (a camera at 0.88 m sees over it); a wall that leaves the mapped
+    band reads as endless; a cell later seen free forgets its height."""
+    box = ((2.02, -0.3, 0.0), (2.4, 0.3, 0.6))
+    grid = OccupancyGrid(OccupancyConfig(depth_stride=1))
+    grid.integrate(render_boxes(Pose2D(0, 0, 0), [box, WALL]))
+    r, c = grid.world_to_cell(np.array([2.05, 0.0]))
+    assert 0.5 <= grid.top[r, c] <= 0.61
+    r, c = grid.world_to_cell(np.array([3.03, 1.5]))
+    assert np.isinf(grid.top[r, c])
+    assert grid.top[grid.state == FREE].max() == 0.0
+    snap = grid.snapshot()
+    assert snap.top.shape == snap.state.shape and not snap.top.flags.writeable
+    grid.integrate(render_boxes(Pose2D(0, 0, 0), [WALL]))  # the box is gone
+    for _ in range(4):
+        grid.integrate(render_boxes(Pose2D(0, 0, 0), [WALL]))
+    r, c = grid.world_to_cell(np.array([2.05, 0.0]))
+    assert cell_state(grid, 2.05, 0.0) == FREE and grid.top[r, c] == 0.0
+
+
 def test_nan_inf_zero_negative_depth_never_corrupts_the_map():
     frame = render_boxes(Pose2D(0, 0, 0), [WALL])
     clean = OccupancyGrid(OccupancyConfig(depth_stride=1))

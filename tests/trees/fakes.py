@@ -16,6 +16,7 @@ class FakeGrid:
     inflated: np.ndarray
     origin: np.ndarray = field(default_factory=lambda: np.zeros(2))
     resolution: float = 0.1
+    top: np.ndarray | None = None  # obstacle heights (None: a 2D map)
 
 
 def open_grid(n: int = 100) -> FakeGrid:

@@ -225,6 +225,25 @@ def test_verify_does_not_count_frames_with_a_wall_between_camera_and_candidate(t
         assert any("0 of 4 frames" in why for _, why in ctx.rejections) == rejected
 
 
+def test_verify_counts_frames_over_low_clutter_but_not_through_walls(tmp_path):
+    """Gibson Allensville/0/0: a sofa seen over an unlabelled 0.8 m table (occupied on the 2D map,
+    explained by no memory object) was in view in none of 8 frames that observed it. With obstacle
+    heights on the map, a camera sees the candidate's top over low clutter, not through a wall."""
+    from .fakes import open_grid
+
+    for top, counted in ((0.3, True), (np.inf, False), (0.0, False)):
+        grid = open_grid()
+        grid.state[38:46, 42] = 1  # occupied cells across the line from (4, 4) to the bed at (5, 5)
+        grid.top = np.zeros(grid.state.shape, dtype=np.float32)
+        grid.top[38:46, 42] = top  # 0: no height recorded, a wall as far as anyone knows
+        ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 4, reposition_after: 100")
+        tree.tick()
+        for aid in range(2, 8):
+            ctx.world = world(FACING_BED, [obj(3, "bed", 5.0, 5.0)], grid=grid, anchors=[anchor(aid, FACING_BED)])
+            tree.tick()
+        assert any("0 of 4 frames" in why for _, why in ctx.rejections) == counted, top
+
+
 def test_verify_counts_only_frames_with_the_candidate_in_view(tmp_path):
     away = Pose2D(4.0, 4.0, math.pi)  # the bed is behind the robot
     ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 5", away)
@@ -742,6 +761,11 @@ def test_wall_clear_sees_past_known_furniture_but_not_past_walls():
     assert clear.tolist() == [False, True, False]  # behind the wall; same side; behind the wall
     assert wall_clear(grid, np.array([[2.0, 5.0]]), np.array([4.0, 5.0]), [table]).tolist() == [True]
     assert wall_clear(grid, np.array([[2.0, 5.0]]), np.array([4.0, 5.0]), []).tolist() == [False]
+    # with heights: the line from a camera 0.9 m up to a top 0.8 m up passes over a 0.5 m obstacle
+    grid.top = np.zeros(grid.state.shape, dtype=np.float32)
+    grid.top[grid.state == 1] = 0.5
+    assert wall_clear(grid, np.array([[2.0, 5.0]]), np.array([4.0, 5.0]), [], heights=(0.9, 0.8)).tolist() == [True]
+    assert wall_clear(grid, np.array([[2.0, 5.0]]), np.array([4.0, 5.0]), [], heights=(0.5, 0.4)).tolist() == [False]
 
 
 def test_verify_out_of_range_after_the_box_moved_goes_to_a_new_cell_instead_of_glancing(tmp_path):

@@ -492,9 +492,11 @@ class VerifyTarget(_GoToObject):
         # memory object's box does
         grid = self.context.grid
         if grid is not None:
-            cams = np.array([np.asarray(a.T_world_cam, dtype=np.float64)[:2, 3] for a in fresh])
+            cams = np.array([np.asarray(a.T_world_cam, dtype=np.float64)[:3, 3] for a in fresh])
             known = [(np.asarray(o.box_min), np.asarray(o.box_max)) for o in memory.objects]
-            walls_clear = wall_clear(grid, cams, np.asarray(cand.center, dtype=np.float64)[:2], known)
+            # the line to the candidate's top: its highest part is what shows over low furniture
+            walls_clear = wall_clear(grid, cams[:, :2], np.asarray(cand.center, dtype=np.float64)[:2], known,
+                                     heights=(cams[:, 2], float(np.asarray(cand.box_max)[2])))
         else:
             walls_clear = np.ones(len(fresh), dtype=bool)
         for a, clear in zip(fresh, walls_clear):
