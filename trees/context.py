@@ -87,6 +87,8 @@ class MissionContext:
     # see that frontier from there (floor below its field of view, walls nearer than its minimum
     # depth), so going back would only repeat the visit; shared by every Explore instance
     spent_viewpoints: list[tuple[float, float]] = field(default_factory=list)
+    # centroids of spent frontiers Explore drove into (``push_through``): one push per spot
+    pushed_frontiers: list[tuple[float, float]] = field(default_factory=list)
     # quarter turns in place done at the mission's start (Explore's start_look_turns); shared by
     # every Explore instance, so the look-around happens once per mission
     start_looks: int = 0

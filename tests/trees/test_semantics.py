@@ -798,3 +798,38 @@ def test_requalify_observations_zero_keeps_a_label_flip_deferred_for_its_time():
     assert ctx.excluded(3)
     clock.t = 31.0
     assert not ctx.excluded(3)
+
+
+def test_explore_pushes_once_into_a_spent_frontier_beside_the_robot(tmp_path):
+    """Gibson Tolstoy/0/2: the passage to the toilet opened at the robot's side, below the
+    camera's view; its frontier's viewpoint was spent and the mission ended with "no frontier
+    left" after 33 of 500 steps. A spent frontier beside the robot is driven into once, through
+    unknown floor, before it is skipped; the push ends at its time limit."""
+    clock, ctx, tree = _reach_first_frontier(tmp_path)
+    ctx.world = world(Pose2D(8.0, 8.0, 0.0))  # at the viewpoint it reached
+    tree.tick()
+    clock.t = 6.0
+    ctx.plan = _plan_at(5.5, (9, (8.3, 8.0)), (10, (1.0, 8.0)))  # still a frontier there
+    tree.tick()
+    assert ctx.spent_viewpoints == [(8.0, 8.0)]
+    push = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert push.ref_id == 9 and push.through_unknown
+    assert abs(push.x - 8.9) < 1e-9 and abs(push.y - 8.0) < 1e-9  # push_m beyond the centroid
+    clock.t = 10.0
+    ctx.plan = _plan_at(9.5, (11, (8.3, 8.0)), (12, (1.0, 8.0)))
+    tree.tick()  # the push runs on while the plan renumbers the frontier
+    assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal == push
+    clock.t = 12.5  # past push_s: the push ends, and that frontier is not pushed into again
+    tree.tick()
+    last = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert last.ref_id == 12 and not last.through_unknown
+
+
+def test_explore_does_not_push_into_a_spent_frontier_far_from_the_robot(tmp_path):
+    clock, ctx, tree = _reach_first_frontier(tmp_path)  # the robot is reported at (2, 2)
+    tree.tick()
+    clock.t = 6.0
+    ctx.plan = _plan_at(5.5, (9, (8.3, 8.0)), (10, (1.0, 8.0)))
+    tree.tick()
+    last = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert last.ref_id == 10 and not last.through_unknown

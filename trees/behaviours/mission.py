@@ -87,7 +87,12 @@ class Explore(MissionBehaviour):
     after reaching a viewpoint still has a frontier viewpoint within ``spent_radius`` of it,
     that spot is spent (``context.spent_viewpoints``): frontiers seen from there are skipped for
     the rest of the mission, instead of being reached, looked at and chosen again, under a new
-    frontier id, for hundreds of steps.
+    frontier id, for hundreds of steps. Before it is skipped, a spent frontier within
+    ``push_radius`` of the robot is pushed into once (``push_through``): the robot drives to
+    ``push_m`` beyond its centroid through floor the map does not know, as a person steps into
+    a doorway to look along the corridor behind it (Gibson Tolstoy/0/2: the passage to the
+    toilet opened at the robot's side, below the camera's view, and the mission ended with "no
+    frontier left" after 33 of 500 steps).
 
     ``start_look_turns`` quarter turns in place come first, once per mission (the count lives in
     the context, so a retried Explore goes on where a preempted one stopped): the camera sees 79
@@ -107,6 +112,11 @@ class Explore(MissionBehaviour):
                                doc="judge a reached viewpoint on plans made this long after the visit"),
         "start_look_turns": Param(int, 0, minimum=0, maximum=100,
                                   doc="quarter turns in place at the mission's start, before any frontier"),
+        "push_through": Param(bool, True, doc="drive once into a nearby frontier whose viewpoint did not clear it"),
+        "push_radius": Param(float, 1.5, minimum=0.0, maximum=10.0,
+                             doc="push only into spent frontiers whose centroid is this near the robot"),
+        "push_m": Param(float, 0.6, minimum=0.0, maximum=5.0, doc="the push goal lies this far beyond the centroid"),
+        "push_s": Param(float, 6.0, minimum=0.1, maximum=600.0, doc="clock seconds a push may take"),
     }
 
     def initialise(self) -> None:
@@ -118,6 +128,7 @@ class Explore(MissionBehaviour):
         self._visited: set[int] = set()
         self._reached: list[tuple[np.ndarray, float]] = []  # viewpoint, clock time: awaiting a newer plan
         self._start_look = False  # the goal in flight is one of the start's quarter turns
+        self._push_at: float | None = None  # clock time the push in flight was sent
 
     def _quarter_turn(self, pose: Pose2D) -> None:
         """Turn in place a quarter turn to the left (a "look" goal); no frontier is pursued."""
@@ -157,9 +168,28 @@ class Explore(MissionBehaviour):
                                            f"({xy[0]:.2f}, {xy[1]:.2f}) spent: reached, not cleared")
         self._reached = waiting
 
-    def _pick(self) -> tuple[int, np.ndarray, float | None] | None:
-        """(frontier id, viewpoint xy, yaw facing the frontier's centroid or None) of the first
-        frontier of the plan's order that is neither visited nor seen from a spent spot."""
+    def _push_goal(self, centroid: np.ndarray) -> tuple[np.ndarray, float] | None:
+        """(goal xy, yaw) ``push_m`` beyond a spent frontier's ``centroid``, away from the robot,
+        or None: pushing is off, the centroid is beyond ``push_radius`` or was pushed before."""
+        pose = self.context.pose
+        if not self.param("push_through") or pose is None:
+            return None
+        robot = np.array([pose.x, pose.y])
+        d = centroid - robot
+        dist = float(np.hypot(*d))
+        r = self.param("spent_radius")
+        if dist > self.param("push_radius") or any(math.hypot(centroid[0] - px, centroid[1] - py) <= r
+                                                   for px, py in self.context.pushed_frontiers):
+            return None
+        yaw = math.atan2(d[1], d[0]) if dist > 0.1 else pose.yaw
+        goal = centroid + self.param("push_m") * np.array([math.cos(yaw), math.sin(yaw)])
+        return goal, yaw
+
+    def _pick(self) -> tuple[int, np.ndarray, float | None, bool] | None:
+        """(frontier id, goal xy, yaw or None, push) for the first frontier of the plan's order
+        that is not visited: its viewpoint facing its centroid, or, where that viewpoint is spent,
+        a push into it (``_push_goal``); frontiers seen from spent spots that cannot be pushed
+        into are skipped."""
         msg = self.context.plan
         if msg is None:
             return None
@@ -171,17 +201,26 @@ class Explore(MissionBehaviour):
         for fid in order:
             if fid in frontiers and fid not in self._visited:
                 xy = np.asarray(frontiers[fid].viewpoint, dtype=np.float64)
+                centroid = np.asarray(frontiers[fid].centroid, dtype=np.float64)
                 if not self._spent(xy):
-                    d = np.asarray(frontiers[fid].centroid, dtype=np.float64) - xy
+                    d = centroid - xy
                     yaw = math.atan2(d[1], d[0]) if float(np.hypot(*d)) > 0.2 else None
-                    return fid, xy, yaw
+                    return fid, xy, yaw, False
+                push = self._push_goal(centroid)
+                if push is not None:
+                    self.context.pushed_frontiers.append((float(centroid[0]), float(centroid[1])))
+                    return fid, push[0], push[1], True
         return None
 
     def update(self) -> Status:
         ctx = self.context
         now = ctx.now()
         state = None if self._seq is None else ctx.nav_state(self._seq)
+        if self._push_at is not None and state not in ("reached", "failed") and \
+                now - self._push_at > self.param("push_s"):
+            state = "failed"  # a push blocked by what the map does not know: rocking on gains nothing
         if state in ("reached", "failed"):
+            self._push_at = None
             if self._frontier is not None:
                 self._visited.add(self._frontier)  # reached but still a frontier, or unreachable: move on
                 if state == "reached" and self._goal_xy is not None:
@@ -193,6 +232,10 @@ class Explore(MissionBehaviour):
         if ctx.start_looks < self.param("start_look_turns"):
             return self._look_around_start()
         self._settle_reached()
+        if self._push_at is not None and self._seq is not None:
+            ctx.last_frontier_time = now
+            self.feedback_message = f"pushing into frontier #{self._frontier}"
+            return Status.RUNNING  # a push runs to its end: the frontier it enters changes as it goes
         pick = self._pick()
         if pick is None:
             if self._frontier is not None and self._seq is not None:
@@ -224,12 +267,15 @@ class Explore(MissionBehaviour):
             self.feedback_message = "looking around" if self._seq is not None else "waiting for a frontier"
             return Status.RUNNING
         ctx.last_frontier_time = now
-        fid, xy, yaw = pick
+        fid, xy, yaw, push = pick
         moved = self._goal_xy is None or float(np.hypot(*(xy - self._goal_xy))) > self.param("switch_distance")
-        if self._seq is None or fid != self._frontier or moved:
+        if self._seq is None or fid != self._frontier or moved or push:
             self._seq = ctx.send_goal(Goal(float(xy[0]), float(xy[1]), yaw, self.param("goal_tolerance"),
-                                           "frontier", int(fid)))
+                                           "frontier", int(fid), through_unknown=push))
             self._frontier, self._goal_xy = fid, xy
+            if push:
+                self._push_at = now
+                ctx.log(f"pushing into frontier #{fid}: its viewpoint did not clear it")
         self.feedback_message = f"frontier #{fid}"
         return Status.RUNNING
 
