@@ -257,3 +257,18 @@ def test_virtual_obstacles_that_wall_the_robot_in_are_cleared_when_no_path_is_le
         nav._add_virtual_obstacle(Pose2D(pose.x, pose.y, float(yaw)))
     assert nav.step(snapshot(s), pose) != DiscreteAction.STOP
     assert nav.status == "following" and nav._virtual == []
+
+
+def test_a_creep_through_unknown_floor_plans_on_the_robot_radius_alone():
+    """A creep toward an object (``Goal.through_unknown``) ends inside the inflation margin, as the
+    robot radius allows; on the normal mask its goal snapped back to a roomy cell the robot had
+    already reached (Gibson Ranchester/0/1 ended 0.96 m from a plant, 0.85 m was reachable)."""
+    grid = _doorway_grid(0)  # a wall at x = 2.5 m: inflated from 2.27 m, lethal from 2.32 m
+    creep = Navigator()
+    creep.set_goal(Goal(2.3, 2.5, tolerance=0.1, through_unknown=True))
+    assert creep.plan(grid, Pose2D(1.0, 2.5, 0.0)) and creep.tight
+    assert abs(creep.path_xy[-1][0] - 2.3) <= 0.05
+    roomy = Navigator()
+    roomy.set_goal(Goal(2.3, 2.5, tolerance=0.1))
+    assert roomy.plan(grid, Pose2D(1.0, 2.5, 0.0)) and not roomy.tight
+    assert roomy.path_xy[-1][0] <= 2.275  # the last roomy cell
