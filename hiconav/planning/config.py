@@ -52,6 +52,10 @@ class NavigatorConfig(BaseModel):
     tight_fallback: bool = Field(
         True, description="when no path keeps the inflation margin, plan through passages only the robot radius clears"
     )
+    trail_free: bool = Field(
+        True, description="cells the robot centre has passed through are traversable (it stood there), "
+        "even where the map's inflation closes them"
+    )
     replan_every: int = Field(10, ge=1, description="re-plan at least every n steps")
     deviation_m: float = Field(0.5, gt=0.0, description="re-plan when this far from the path")
     stuck_progress_m: float = Field(0.05, ge=0.0, description="a forward step moving less than this is stuck")

@@ -94,6 +94,8 @@ class Navigator:
         self._virtual: list[tuple[float, float, float]] = []  # (x, y, radius) where the robot got stuck
         self._last_pose: Pose2D | None = None
         self._last_action: DiscreteAction | None = None
+        # world xy where the robot centre has been, a point every TRAIL_STEP_M: traversable
+        self._trail: list[tuple[float, float]] = []
         self._stuck = 0
         self._recovery: list[DiscreteAction] = []
         self._vel_recovery: list[tuple[float, float, float]] = []  # (v, omega, seconds)
@@ -126,12 +128,44 @@ class Navigator:
     def clear_virtual_obstacles(self) -> None:
         self._virtual.clear()
 
+    # trail points are kept this far apart; consecutive points farther apart than TRAIL_GAP_M
+    # (a pose jump: relocalisation, a new episode) are not joined
+    TRAIL_STEP_M = 0.05
+    TRAIL_GAP_M = 0.6
+
+    def _record_trail(self, pose: Pose2D) -> None:
+        if not self._trail or math.hypot(pose.x - self._trail[-1][0], pose.y - self._trail[-1][1]) >= self.TRAIL_STEP_M:
+            self._trail.append((float(pose.x), float(pose.y)))
+
+    def _trail_cells(self, grid: GridLike) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, cols) of the cells on the robot's trail (segments between consecutive points)."""
+        pts = np.asarray(self._trail, dtype=np.float64).reshape(-1, 2)
+        if len(pts) == 1:
+            segs = pts
+        else:
+            a, b = pts[:-1], pts[1:]
+            keep = np.hypot(*(b - a).T) <= self.TRAIL_GAP_M
+            t = np.linspace(0.0, 1.0, int(math.ceil(self.TRAIL_GAP_M / (0.5 * grid.resolution))) + 1)
+            segs = (a[keep, None, :] + t[None, :, None] * (b - a)[keep, None, :]).reshape(-1, 2)
+            segs = np.concatenate([segs, pts[-1:]])
+        rc = grid.world_to_cell(segs)
+        h, w = grid.state.shape
+        ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
+        return rc[ok, 0], rc[ok, 1]
+
     # ------------------------------------------------------------------ planning
     def _blocked(self, grid: GridLike, start_rc: np.ndarray, tight: bool = False) -> np.ndarray:
         cfg = self.config
         through_unknown = cfg.plan_through_unknown or (self.goal is not None and self.goal.through_unknown)
         blocked = blocked_cells(grid, through_unknown=through_unknown, tight=tight)
         res = grid.resolution
+        if cfg.trail_free and self._trail:
+            # where the robot centre has been it fits (the world is static to this map): a gap between
+            # furniture that the map's inflation closes behind the robot is no trap (Gibson
+            # Lakeville/0/3 rocked for 140 steps between two obstacles, its own cell lethal on the map,
+            # no way out on it); an obstacle seen there since still blocks
+            rows, cols = self._trail_cells(grid)
+            blocked[rows, cols] &= grid.state[rows, cols] == 1
         for x, y, r in self._virtual:
             rc = grid.world_to_cell(np.array([x, y]))
             rs, cs, m = _disk(blocked, rc, r / res)
@@ -256,8 +290,11 @@ class Navigator:
         return False
 
     def _open_side(self, grid: GridLike, pose: Pose2D) -> int:
-        """+1 if the left (CCW) side is more open than the right, else -1 (ray casting)."""
-        blocked = blocked_cells(grid, through_unknown=True)
+        """+1 if the left (CCW) side is more open than the right, else -1 (ray casting to the
+        occupied cells: a stuck robot often stands inside the inflation, where rays on the
+        inflated mask end at once on both sides and the tie turned it toward the nearer wall;
+        Gibson Lakeville/0/3 rocked so for 140 steps, 0.15 m from one obstacle, 0.3 m from the other)."""
+        blocked = np.asarray(grid.state) == 1
         rc = grid.world_to_cell(pose.xy) + 0.5
         angles = pose.yaw + np.array([math.pi / 2, math.pi / 3, -math.pi / 2, -math.pi / 3])
         d = ray_cast_grid(blocked, (float(rc[0]), float(rc[1])), angles, 2.0 / grid.resolution)
@@ -275,6 +312,7 @@ class Navigator:
         """The next discrete action toward the goal (STOP when reached or when there is no path)."""
         cfg = self.config
         self._ticks_since_plan += 1
+        self._record_trail(pose)
         if self.goal is None:
             self.status = "idle"
             return self._act(DiscreteAction.STOP, pose)
@@ -363,6 +401,7 @@ class Navigator:
         cfg = self.config
         self._ticks_since_plan += 1
         self._elapsed += dt
+        self._record_trail(pose)
         if self.goal is None:
             self.status = "idle"
             return VelocityCommand.zero(stamp)

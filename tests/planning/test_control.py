@@ -272,3 +272,16 @@ def test_a_creep_through_unknown_floor_plans_on_the_robot_radius_alone():
     roomy.set_goal(Goal(2.3, 2.5, tolerance=0.1))
     assert roomy.plan(grid, Pose2D(1.0, 2.5, 0.0)) and not roomy.tight
     assert roomy.path_xy[-1][0] <= 2.275  # the last roomy cell
+
+
+def test_a_stuck_robot_inside_the_inflation_turns_toward_the_farther_obstacle():
+    """Gibson Lakeville/0/3: between two obstacles 0.45 m apart, inside the inflation of both, the
+    rays on the inflated mask ended at once on either side and the tie turned the robot toward
+    the nearer obstacle, for 140 steps. Rays to the occupied cells see which side is open."""
+    s = open_room()
+    s[45, 20:80] = 1  # y 2.25-2.30
+    s[52, 20:80] = 1  # y 2.60-2.65
+    grid = snapshot(s)
+    nav = Navigator()
+    assert nav._open_side(grid, Pose2D(2.5, 2.40, math.pi)) == -1  # facing west: north, to its right
+    assert nav._open_side(grid, Pose2D(2.5, 2.40, 0.0)) == 1  # facing east: north, to its left
