@@ -833,3 +833,22 @@ def test_explore_does_not_push_into_a_spent_frontier_far_from_the_robot(tmp_path
     tree.tick()
     last = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
     assert last.ref_id == 10 and not last.through_unknown
+
+
+def test_explore_skips_a_frontier_it_comes_no_nearer_to(tmp_path):
+    """Gibson Tolstoy/0/3: the map showed a corridor open that the robot does not fit through; it
+    rocked at the mouth for all 500 steps. No 0.25 m nearer in stall_s: the next frontier."""
+    clock = Clock()
+    ctx = _ctx(clock)  # the robot stays at (2, 2)
+    ctx.plan = _plan_at(0.0, (0, (8.0, 8.0)), (1, (1.0, 8.0)))
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {stall_s: 8}\n"), ctx)
+    tree.tick()
+    clock.t = 0.1
+    tree.tick()
+    clock.t = 7.0
+    tree.tick()
+    assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.ref_id == 0
+    clock.t = 8.5
+    tree.tick()
+    assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.ref_id == 1
+    assert any("no progress" in e for e in ctx.events)

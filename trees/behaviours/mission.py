@@ -117,6 +117,8 @@ class Explore(MissionBehaviour):
                              doc="push only into spent frontiers whose centroid is this near the robot"),
         "push_m": Param(float, 0.6, minimum=0.0, maximum=5.0, doc="the push goal lies this far beyond the centroid"),
         "push_s": Param(float, 6.0, minimum=0.1, maximum=600.0, doc="clock seconds a push may take"),
+        "stall_s": Param(float, 8.0, minimum=0.1, maximum=600.0,
+                         doc="a frontier goal the robot came no nearer to (by 0.25 m) for this long is skipped"),
     }
 
     def initialise(self) -> None:
@@ -129,6 +131,7 @@ class Explore(MissionBehaviour):
         self._reached: list[tuple[np.ndarray, float]] = []  # viewpoint, clock time: awaiting a newer plan
         self._start_look = False  # the goal in flight is one of the start's quarter turns
         self._push_at: float | None = None  # clock time the push in flight was sent
+        self._progress: tuple[float, float] | None = None  # (best distance to the goal, clock time)
 
     def _quarter_turn(self, pose: Pose2D) -> None:
         """Turn in place a quarter turn to the left (a "look" goal); no frontier is pursued."""
@@ -145,6 +148,17 @@ class Explore(MissionBehaviour):
         ctx.last_frontier_time = ctx.now()  # looking around is progress
         self.feedback_message = f"looking around the start ({ctx.start_looks}/{self.param('start_look_turns')})"
         return Status.RUNNING
+
+    def _stalled(self, now: float) -> bool:
+        """True when the robot came no nearer to the goal in flight (by 0.25 m) for ``stall_s``."""
+        pose, goal = self.context.pose, self._goal_xy
+        if pose is None or goal is None or self._seq is None:
+            return False
+        d = math.hypot(pose.x - goal[0], pose.y - goal[1])
+        if self._progress is None or d < self._progress[0] - 0.25 or d <= 0.35:
+            self._progress = (d, now)
+            return False
+        return now - self._progress[1] > self.param("stall_s")
 
     def _spent(self, xy: np.ndarray) -> bool:
         r = self.param("spent_radius")
@@ -219,6 +233,12 @@ class Explore(MissionBehaviour):
         if self._push_at is not None and state not in ("reached", "failed") and \
                 now - self._push_at > self.param("push_s"):
             state = "failed"  # a push blocked by what the map does not know: rocking on gains nothing
+        if self._frontier is not None and state not in ("reached", "failed") and self._stalled(now):
+            # no nearer to the frontier's viewpoint in stall_s: a passage the map thinks open that the
+            # robot does not fit through (Gibson Tolstoy/0/3 rocked at a corridor's mouth for all 500
+            # steps while the passage to the toilet opened beside it); move on to the next frontier
+            ctx.log(f"frontier #{self._frontier}: no progress for {self.param('stall_s'):.0f} s, skipped")
+            state = "failed"
         if state in ("reached", "failed"):
             self._push_at = None
             if self._frontier is not None:
@@ -273,6 +293,7 @@ class Explore(MissionBehaviour):
             self._seq = ctx.send_goal(Goal(float(xy[0]), float(xy[1]), yaw, self.param("goal_tolerance"),
                                            "frontier", int(fid), through_unknown=push))
             self._frontier, self._goal_xy = fid, xy
+            self._progress = None
             if push:
                 self._push_at = now
                 ctx.log(f"pushing into frontier #{fid}: its viewpoint did not clear it")
