@@ -182,6 +182,10 @@ class Goal:
     # the path may cross unknown cells: the last short creep toward an object whose nearby floor
     # the camera never saw (it sees no floor nearer than ~1.4 m; see ``Approach``)
     through_unknown: bool = False
+    # drive straight at the point without a plan (discrete control), until within the tolerance,
+    # half a step from it, or a forward step is blocked: the last centimetres of a creep, where the
+    # map's cells and margins are coarser than the gap left (see ``Navigator``)
+    straight: bool = False
 
     @property
     def xy(self) -> np.ndarray:

@@ -285,3 +285,35 @@ def test_a_stuck_robot_inside_the_inflation_turns_toward_the_farther_obstacle():
     nav = Navigator()
     assert nav._open_side(grid, Pose2D(2.5, 2.40, math.pi)) == -1  # facing west: north, to its right
     assert nav._open_side(grid, Pose2D(2.5, 2.40, 0.0)) == 1  # facing east: north, to its left
+
+
+def test_a_straight_goal_steps_up_to_the_obstacle_without_a_plan():
+    """``Goal.straight`` (an Approach creep's last centimetres): face the point and step until a
+    step is blocked. The map's lethal zone plus its cells kept a creep 0.11 m short of where the
+    robot fits (Gibson Ranchester/0/1 ended 1.005 m from a plant, success at 1 m)."""
+    grid = _doorway_grid(0)  # a wall at x = 2.50 m; the robot centre fits up to x = 2.32 m
+
+    def run(goal: Goal) -> tuple[Pose2D, Navigator]:
+        nav = Navigator()
+        nav.set_goal(goal)
+        pose = Pose2D(1.55, 2.5, 0.0)
+        for _ in range(30):
+            a = nav.step(grid, pose)
+            if a == DiscreteAction.STOP:
+                break
+            if a == DiscreteAction.MOVE_FORWARD:  # the simulator's partial move, stopped by the wall
+                x = pose.x
+                for _ in range(10):
+                    if x + 0.025 > 2.32:
+                        break
+                    x += 0.025
+                pose = Pose2D(x, pose.y, pose.yaw)
+            elif a in (DiscreteAction.TURN_LEFT, DiscreteAction.TURN_RIGHT):
+                pose = Pose2D(pose.x, pose.y, pose.yaw + math.radians(30 if a == DiscreteAction.TURN_LEFT else -30))
+        return pose, nav
+
+    pose, nav = run(Goal(2.6, 2.5, 0.0, tolerance=0.1, straight=True))
+    assert nav.reached and nav.n_plans == 0 and pose.x >= 2.29  # up to the wall, to within a sub-step
+    assert nav.step(grid, pose) == DiscreteAction.STOP
+    far, nav = run(Goal(2.0, 2.5, 0.0, tolerance=0.1, straight=True))
+    assert nav.reached and abs(far.x - 2.05) < 1e-9  # within half a step of the point: done

@@ -802,7 +802,8 @@ class Approach(_GoToObject):
         than ~1.4 m (0.88 m up, 32 degrees down), so the floor by an object is often unknown and
         no approach cell lies there; on Gibson five robots stopped 1.0-1.1 m from their target,
         0.96 m from its box on their own map (Ranchester/0/1), where a real robot inches closer.
-        False when the robot is already that close."""
+        The goal is ``straight``: the robot steps toward it until a step is blocked, without a plan
+        on the map's coarser margins. False when the robot is already that close."""
         pose = self.context.pose
         robot = np.array([pose.x, pose.y])
         near = np.clip(robot, np.asarray(cand.box_min, dtype=np.float64)[:2], np.asarray(cand.box_max, dtype=np.float64)[:2])
@@ -815,7 +816,7 @@ class Approach(_GoToObject):
         self._crept_at = self.context.now()
         self._cell = goal
         self._seq = self.context.send_goal(Goal(float(goal[0]), float(goal[1]), _facing(goal, cand.center), 0.1,
-                                                "approach", cand.object_id, through_unknown=True))
+                                                "approach", cand.object_id, through_unknown=True, straight=True))
         return True
 
     def _give_up(self, cand: Candidate, why: str) -> Status:
