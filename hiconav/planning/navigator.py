@@ -96,6 +96,9 @@ class Navigator:
         self._last_action: DiscreteAction | None = None
         # world xy where the robot centre has been, a point every TRAIL_STEP_M: traversable
         self._trail: list[tuple[float, float]] = []
+        # _trail_cells' last answer and what it was computed for (trail length, grid frame): the
+        # path check asks every step, the trail changes every few
+        self._trail_cache: tuple[tuple, tuple[np.ndarray, np.ndarray]] | None = None
         self._stuck = 0
         self._recovery: list[DiscreteAction] = []
         self._vel_recovery: list[tuple[float, float, float]] = []  # (v, omega, seconds)
@@ -139,6 +142,10 @@ class Navigator:
 
     def _trail_cells(self, grid: GridLike) -> tuple[np.ndarray, np.ndarray]:
         """(rows, cols) of the cells on the robot's trail (segments between consecutive points)."""
+        key = (len(self._trail), tuple(np.asarray(grid.origin, dtype=np.float64)), grid.state.shape,
+               float(grid.resolution))
+        if self._trail_cache is not None and self._trail_cache[0] == key:
+            return self._trail_cache[1]
         pts = np.asarray(self._trail, dtype=np.float64).reshape(-1, 2)
         if len(pts) == 1:
             segs = pts
@@ -151,7 +158,9 @@ class Navigator:
         rc = grid.world_to_cell(segs)
         h, w = grid.state.shape
         ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
-        return rc[ok, 0], rc[ok, 1]
+        cells = (rc[ok, 0], rc[ok, 1])
+        self._trail_cache = (key, cells)
+        return cells
 
     # ------------------------------------------------------------------ planning
     def _blocked(self, grid: GridLike, start_rc: np.ndarray, tight: bool = False) -> np.ndarray:

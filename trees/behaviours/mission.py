@@ -73,6 +73,21 @@ class TargetConfirmed(MissionBehaviour):
         return Status.FAILURE
 
 
+def _stalled_toward(behaviour: MissionBehaviour, goal: np.ndarray | None, limit_s: float) -> bool:
+    """True when, with a goal in flight (``behaviour._seq``), the robot has come no nearer to
+    ``goal`` (by 0.25 m, and is not within 0.35 m of it: there, glancing about) for ``limit_s``
+    clock seconds; ``behaviour._progress`` keeps (best distance, clock time) between ticks."""
+    pose = behaviour.context.pose
+    if pose is None or goal is None or getattr(behaviour, "_seq", None) is None:
+        return False
+    d, now = math.hypot(pose.x - goal[0], pose.y - goal[1]), behaviour.context.now()
+    best = getattr(behaviour, "_progress", None)
+    if best is None or d < best[0] - 0.25 or d <= 0.35:
+        behaviour._progress = (d, now)
+        return False
+    return now - best[1] > limit_s
+
+
 @register_behaviour()
 class Explore(MissionBehaviour):
     """Follow the exploration plan: go to the first frontier of the WTRP order, re-planned as the
@@ -149,17 +164,6 @@ class Explore(MissionBehaviour):
         self.feedback_message = f"looking around the start ({ctx.start_looks}/{self.param('start_look_turns')})"
         return Status.RUNNING
 
-    def _stalled(self, now: float) -> bool:
-        """True when the robot came no nearer to the goal in flight (by 0.25 m) for ``stall_s``."""
-        pose, goal = self.context.pose, self._goal_xy
-        if pose is None or goal is None or self._seq is None:
-            return False
-        d = math.hypot(pose.x - goal[0], pose.y - goal[1])
-        if self._progress is None or d < self._progress[0] - 0.25 or d <= 0.35:
-            self._progress = (d, now)
-            return False
-        return now - self._progress[1] > self.param("stall_s")
-
     def _spent(self, xy: np.ndarray) -> bool:
         r = self.param("spent_radius")
         return any(math.hypot(xy[0] - sx, xy[1] - sy) <= r for sx, sy in self.context.spent_viewpoints)
@@ -233,7 +237,8 @@ class Explore(MissionBehaviour):
         if self._push_at is not None and state not in ("reached", "failed") and \
                 now - self._push_at > self.param("push_s"):
             state = "failed"  # a push blocked by what the map does not know: rocking on gains nothing
-        if self._frontier is not None and state not in ("reached", "failed") and self._stalled(now):
+        if self._frontier is not None and state not in ("reached", "failed") and \
+                _stalled_toward(self, self._goal_xy, self.param("stall_s")):
             # no nearer to the frontier's viewpoint in stall_s: a passage the map thinks open that the
             # robot does not fit through (Gibson Tolstoy/0/3 rocked at a corridor's mouth for all 500
             # steps while the passage to the toilet opened beside it); move on to the next frontier
@@ -357,15 +362,7 @@ class _GoToObject(MissionBehaviour):
 
     def _stalled(self) -> bool:
         """True when the robot has made no progress toward the goal cell for ``STALL_S``."""
-        pose, cell = self.context.pose, getattr(self, "_cell", None)
-        if pose is None or cell is None or getattr(self, "_seq", None) is None:
-            return False
-        d, now = math.hypot(pose.x - cell[0], pose.y - cell[1]), self.context.now()
-        best = getattr(self, "_progress", None)
-        if best is None or d < best[0] - 0.25 or d <= 0.35:  # progress, or there (glancing about)
-            self._progress = (d, now)
-            return False
-        return now - best[1] > self.STALL_S
+        return _stalled_toward(self, getattr(self, "_cell", None), self.STALL_S)
 
     def cleanup(self, new_status: Status) -> None:
         if getattr(self, "_seq", None) is not None and self.ctx is not None and new_status != Status.SUCCESS:
