@@ -39,6 +39,7 @@ if TYPE_CHECKING:
 
 SQRT2 = math.sqrt(2.0)
 VIEW_RADIUS = 1.0  # m: traversable cells this close to a goal footprint are its view points
+_SOURCE_EPS = 1e-9  # m: keeps zero-offset source edges in the sparse graph; removed from results
 
 
 def clearance(nav: NavGrid) -> np.ndarray:
@@ -99,13 +100,16 @@ class GridGraph:
         if np.any(src < 0):
             raise ValueError("every source cell must be traversable")
         super_node = self.n
-        # Zero weights would be dropped by the sparse matrix: add a negligible epsilon.
+        # Zero weights would be dropped by the sparse matrix: the super node's edges carry a
+        # negligible epsilon, taken off again below (left in, a robot exactly at the success
+        # distance read 1.000000001 m and failed).
         rows = np.concatenate([self.rows, self.cols, np.full(len(src), super_node)])
         cols = np.concatenate([self.cols, self.rows, src])
-        wts = np.concatenate([self.wts, self.wts, np.asarray(offsets, dtype=np.float64) + 1e-9])
+        wts = np.concatenate([self.wts, self.wts,
+                              np.asarray(offsets, dtype=np.float64) + _SOURCE_EPS])
         graph = coo_matrix((wts, (rows, cols)), shape=(self.n + 1, self.n + 1)).tocsr()
         dist = dijkstra(graph, directed=True, indices=super_node)
-        out[self.cells[:, 0], self.cells[:, 1]] = dist[: self.n]
+        out[self.cells[:, 0], self.cells[:, 1]] = np.maximum(dist[: self.n] - _SOURCE_EPS, 0.0)
         return out
 
 

@@ -57,6 +57,16 @@ def test_scipy_dijkstra_matches_a_heap_reimplementation(seed):
     np.testing.assert_allclose(got[fin], ref[fin], atol=1e-6)
 
 
+def test_a_source_reads_exactly_its_offset_so_a_robot_at_the_success_distance_succeeds():
+    # The sparse graph needs a positive edge weight; that epsilon must not reach the result
+    # (1.000000001 m at a view point exactly 1 m away failed the <= 1 m success test).
+    mask = np.ones((5, 40), dtype=bool)
+    got = GridGraph(mask, 0.05).multi_source(np.array([[2, 0], [2, 39]]), np.array([1.0, 0.0]))
+    assert got[2, 0] == 1.0
+    assert got[2, 39] == 0.0
+    assert got[2, 38] == 0.05
+
+
 def test_goal_distance_in_open_space_is_straight_line_to_the_footprint():
     house = box_room(8.0, [obj(0, "chair", (6.0, 4.0, 0.45), (0.5, 0.5, 0.9))])
     gd = GoalDistance(house, instance_ids=[0])
