@@ -52,6 +52,10 @@ class NavigatorConfig(BaseModel):
     tight_fallback: bool = Field(
         True, description="when no path keeps the inflation margin, plan through passages only the robot radius clears"
     )
+    squeeze_fallback: bool = Field(
+        True, description="a goal through unknown floor (a push into a frontier, a creep) that no path reaches "
+        "on the lethal layer plans once more on it shrunk by one cell"
+    )
     trail_free: bool = Field(
         True, description="cells the robot centre has passed through are traversable (it stood there), "
         "even where the map's inflation closes them"

@@ -12,6 +12,7 @@ from hiconav.mapping import GridSnapshot
 from hiconav.mapping.occupancy import disk_kernel
 from hiconav.planning import Navigator, PurePursuit, heading_action, lookahead_point, to_discrete
 from hiconav.planning.local_planner import segment_target
+from hiconav.planning.navigator import squeeze_mask
 from hiconav.types import DiscreteAction, Goal, Pose2D, VelocityCommand
 
 RES = 0.05
@@ -272,6 +273,35 @@ def test_a_creep_through_unknown_floor_plans_on_the_robot_radius_alone():
     roomy.set_goal(Goal(2.3, 2.5, tolerance=0.1))
     assert roomy.plan(grid, Pose2D(1.0, 2.5, 0.0)) and not roomy.tight
     assert roomy.path_xy[-1][0] <= 2.275  # the last roomy cell
+
+
+def test_a_goal_through_unknown_floor_squeezes_through_a_gap_the_lethal_layer_closes():
+    """The map's occupied cells reach 0.5-1.5 cells past a surface (grid phase): a 0.45 m passage
+    that the 0.36 m robot fits through lost its last lethal-free cell (Gibson Stockman/0/3). A push
+    or a creep (``through_unknown``) plans once more on the lethal layer one cell thinner; an
+    ordinary goal never does, and ``squeeze_fallback`` off restores the old behaviour."""
+    s = open_room()
+    s[:, 50] = 1
+    s[47:53, 50] = 0  # 6 free cells between the occupied ones
+    occ = (s == 1).astype(np.uint8)
+    grid = GridSnapshot(state=s, inflated=cv2.dilate(occ, disk_kernel(4.1)).astype(bool),
+                        lethal=cv2.dilate(occ, disk_kernel(3.1)).astype(bool), explored=s != -1,
+                        origin=np.zeros(2), resolution=RES, version=1, stamp=0.0)
+    ordinary = Navigator()
+    ordinary.set_goal(Goal(4.0, 2.5, tolerance=0.25))
+    assert not ordinary.plan(grid, Pose2D(1.0, 2.5, 0.0))
+    push = Navigator()
+    push.set_goal(Goal(4.0, 2.5, tolerance=0.25, through_unknown=True))
+    assert push.plan(grid, Pose2D(1.0, 2.5, 0.0)) and push.squeeze and push.tight
+    crossing = [p for p in push._dense_xy if 2.5 <= p[0] <= 2.55]  # the wall's column
+    assert crossing and all(2.35 <= p[1] <= 2.65 for p in crossing)  # through the gap itself
+    off = Navigator()
+    off.config.squeeze_fallback = False
+    off.set_goal(Goal(4.0, 2.5, tolerance=0.25, through_unknown=True))
+    assert not off.plan(grid, Pose2D(1.0, 2.5, 0.0))
+    # the squeeze mask keeps every occupied cell blocked and only ever frees lethal cells
+    sq = squeeze_mask(grid)
+    assert sq[occ.astype(bool)].all() and not (sq & ~grid.lethal).any()
 
 
 def test_a_stuck_robot_inside_the_inflation_turns_toward_the_farther_obstacle():
