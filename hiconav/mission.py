@@ -357,6 +357,7 @@ class _RobotTracker:
         self.robot = robot
         self.config = sim_cfg
         self.goal = GoalDistance(house, episode, radius=sim_cfg.robot_radius)
+        self.shortest_to_success = self.goal.to_success(episode.start.xy, sim_cfg.success_distance)
 
     def finish(self) -> Any:
         from hiconav.sim.metrics import episode_metrics
@@ -364,7 +365,8 @@ class _RobotTracker:
         r = self.robot
         return episode_metrics(self.episode, final_distance=self.goal.distance(r.pose.xy),
                                path_length=float(r.path_length), steps=int(r.steps), stopped=bool(r.stopped),
-                               collisions=0, config=self.config)
+                               collisions=0, shortest_to_success=self.shortest_to_success,
+                               config=self.config)
 
 
 def _run_robot(runtime: Any, robot: Any, max_time: float) -> Any:

@@ -98,6 +98,8 @@ class EpisodeRecord:
         ``last_progress_step``, ``task_time_s``, ``layer_time_s``, ``vlm_calls``, ``detector``."""
         extra = dict(fields_.pop("extra", None) or {})
         extra.setdefault("collisions", int(getattr(metrics, "collisions", 0)))
+        if getattr(metrics, "shortest_to_success", None) is not None:
+            extra.setdefault("shortest_to_success", float(metrics.shortest_to_success))  # SPL's l
         return EpisodeRecord(episode_id=str(metrics.episode_id), house=str(metrics.house),
                              target=str(metrics.target), success=bool(metrics.success),
                              spl=float(metrics.spl), dts=float(metrics.dts), steps=int(metrics.steps),

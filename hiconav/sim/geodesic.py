@@ -232,17 +232,42 @@ class GoalDistance:
         A position whose cell is not traversable (e.g. a start pressed against a wall) uses the
         nearest reachable cell within 0.5 m plus the straight distance to it.
         """
+        return self._lookup(self.field, xy)
+
+    def success_field(self, success_distance: float) -> np.ndarray:
+        """(H, W) geodesic metres from each cell to the nearest cell of the success region (the
+        cells whose ``field`` is at most ``success_distance``; 0 inside it, inf if unreachable)."""
+        key = ("success", self.instance_ids, round(self.radius, 6), round(float(success_distance), 9))
+        cached = self.house._cache.get(key)
+        if cached is None:
+            region = np.argwhere(self.field <= float(success_distance))
+            graph = house_graph(self.house, self.radius)
+            cached = graph.multi_source(region, np.zeros(len(region)))
+            cached.flags.writeable = False
+            self.house._cache[key] = cached
+        return cached
+
+    def to_success(self, xy: np.ndarray, success_distance: float) -> float:
+        """Geodesic metres from world ``xy`` to the success region: the shortest path an agent
+        must travel to succeed, the l of SPL (Habitat ObjectNav measures it to the goal's view
+        points). ``distance(xy) - success_distance`` is only a lower bound of it: the nearest
+        point of the region may lie along another route than the nearest footprint cell."""
+        return self._lookup(self.success_field(success_distance), xy)
+
+    def _lookup(self, field: np.ndarray, xy: np.ndarray) -> float:
+        """``field`` at world ``xy``; off the traversable cells, the nearest finite cell within
+        0.5 m plus the straight distance to it (inf if none)."""
         nav = self.house.nav
         rc = nav.world_to_cell(np.asarray(xy, dtype=np.float64)[:2])
-        if nav.in_bounds(rc) and np.isfinite(self.field[rc[0], rc[1]]):
-            return float(self.field[rc[0], rc[1]])
+        if nav.in_bounds(rc) and np.isfinite(field[rc[0], rc[1]]):
+            return float(field[rc[0], rc[1]])
         r = math.ceil(0.5 / nav.resolution)
         h, w = nav.shape
         r0, r1 = max(rc[0] - r, 0), min(rc[0] + r + 1, h)
         c0, c1 = max(rc[1] - r, 0), min(rc[1] + r + 1, w)
         if r1 <= r0 or c1 <= c0:
             return math.inf
-        win = self.field[r0:r1, c0:c1]
+        win = field[r0:r1, c0:c1]
         rr, cc = np.nonzero(np.isfinite(win))
         if len(rr) == 0:
             return math.inf

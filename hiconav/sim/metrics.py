@@ -1,8 +1,13 @@
 """ObjectNav metrics: success, SPL, DTS and a per-episode record.
 
 Success: the agent calls ``stop`` within ``success_distance`` m (geodesic, to the nearest
-goal-instance footprint) within ``max_steps`` actions. SPL = S * l / max(l, p) with l the
-shortest geodesic start-goal distance and p the path length (Anderson et al. 2018). DTS: the
+goal-instance footprint) within ``max_steps`` actions. SPL = S * l / max(l, p) with p the path
+length and l the shortest path that succeeds: the geodesic distance from the start to the
+success region (the cells within ``success_distance`` of the goal), as Habitat's ObjectNav
+measures it to the goal's view points (Anderson et al. 2018; Batra et al. 2020). Measured to
+the goal object itself, l exceeds the shortest successful path by up to the success distance:
+an agent that stopped on the region's edge after 0.97 m scored SPL 1 against an "l" of 1.57 m
+(Gibson Stockman/0/1), and SPL over-stated efficiency most on the shortest episodes. DTS: the
 geodesic distance to the success region at the end, max(0, d_T - success_distance). This module
 scores episodes; it must not move the robot.
 """
@@ -41,29 +46,34 @@ class EpisodeMetrics:
     spl: float
     dts: float
     final_distance: float
-    shortest: float
+    shortest: float  # geodesic start-goal distance (m)
     path_length: float
     steps: int
     collisions: int
     stopped: bool
+    shortest_to_success: float = 0.0  # geodesic start to success-region distance: SPL's l (m)
 
     def to_json(self) -> dict[str, Any]:
         return asdict(self)
 
 
 def episode_metrics(episode: Episode, *, final_distance: float, path_length: float,
-                    steps: int, stopped: bool, collisions: int = 0,
+                    steps: int, stopped: bool, shortest_to_success: float, collisions: int = 0,
                     config: SimConfig | None = None) -> EpisodeMetrics:
-    """Score an episode from its end state (hand-made cases in tests use this directly)."""
+    """Score an episode from its end state (hand-made cases in tests use this directly).
+
+    ``shortest_to_success``: the geodesic distance from the start to the success region (SPL's l;
+    ``GoalDistance.to_success``)."""
     cfg = config or SimConfig()
     success = bool(stopped and steps <= cfg.max_steps and
                    final_distance <= cfg.success_distance)
     return EpisodeMetrics(
         episode_id=episode.episode_id, house=episode.house, target=episode.target,
-        success=success, spl=spl(success, episode.geodesic_distance, path_length),
+        success=success, spl=spl(success, shortest_to_success, path_length),
         dts=dts(final_distance, cfg.success_distance), final_distance=float(final_distance),
         shortest=float(episode.geodesic_distance), path_length=float(path_length),
-        steps=int(steps), collisions=int(collisions), stopped=bool(stopped))
+        steps=int(steps), collisions=int(collisions), stopped=bool(stopped),
+        shortest_to_success=float(shortest_to_success))
 
 
 class EpisodeTracker:
@@ -73,6 +83,7 @@ class EpisodeTracker:
         self.sim = sim
         self.episode = episode
         self.goal = GoalDistance(sim.house, episode, radius=sim.config.robot_radius)
+        self.shortest_to_success = self.goal.to_success(episode.start.xy, sim.config.success_distance)
 
     @property
     def done(self) -> bool:
@@ -83,4 +94,4 @@ class EpisodeTracker:
         return episode_metrics(self.episode, final_distance=self.goal.distance(sim.pose.xy),
                                path_length=sim.path_length, steps=sim.steps,
                                stopped=sim.stopped, collisions=sim.collisions,
-                               config=sim.config)
+                               shortest_to_success=self.shortest_to_success, config=sim.config)

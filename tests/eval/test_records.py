@@ -68,7 +68,8 @@ def test_record_from_simulator_metrics(tmp_path) -> None:
     from hiconav.types import Pose2D
 
     episode = episodes.Episode("e1", "procthor:val/0", Pose2D(0, 0, 0), "bed", (3,), 4.0, "find the bed")
-    metrics = sim_metrics.episode_metrics(episode, final_distance=0.5, path_length=8.0, steps=40, stopped=True)
+    metrics = sim_metrics.episode_metrics(episode, final_distance=0.5, path_length=8.0, steps=40, stopped=True,
+                                           shortest_to_success=4.0)
     record = EpisodeRecord.from_metrics(metrics, termination="stop", max_steps=500, vlm_calls=2, detector="oracle")
     assert record.success and record.spl == pytest.approx(0.5) and record.dts == 0.0
     assert (record.geodesic_distance, record.steps, record.vlm_calls) == (4.0, 40, 2)

@@ -26,17 +26,17 @@ def test_dts_cases():
 
 
 def test_success_needs_stop_within_distance_and_steps():
-    ok = episode_metrics(EP, final_distance=0.9, path_length=5.0, steps=40, stopped=True)
+    ok = episode_metrics(EP, final_distance=0.9, path_length=5.0, steps=40, stopped=True, shortest_to_success=4.0)
     assert ok.success and ok.spl == pytest.approx(0.8) and ok.dts == 0.0
-    no_stop = episode_metrics(EP, final_distance=0.9, path_length=5.0, steps=500, stopped=False)
+    no_stop = episode_metrics(EP, final_distance=0.9, path_length=5.0, steps=500, stopped=False, shortest_to_success=4.0)
     assert not no_stop.success and no_stop.spl == 0.0
-    far = episode_metrics(EP, final_distance=1.2, path_length=5.0, steps=40, stopped=True)
+    far = episode_metrics(EP, final_distance=1.2, path_length=5.0, steps=40, stopped=True, shortest_to_success=4.0)
     assert not far.success and far.dts == pytest.approx(0.2)
-    late = episode_metrics(EP, final_distance=0.5, path_length=5.0, steps=501, stopped=True)
+    late = episode_metrics(EP, final_distance=0.5, path_length=5.0, steps=501, stopped=True, shortest_to_success=4.0)
     assert not late.success
     cfg = SimConfig(success_distance=1.5)
     assert episode_metrics(EP, final_distance=1.2, path_length=5.0, steps=40, stopped=True,
-                           config=cfg).success
+                           shortest_to_success=4.0, config=cfg).success
     assert ok.to_json()["episode_id"] == "e1"
 
 
@@ -65,4 +65,8 @@ def test_tracker_scores_a_simulated_episode():
     assert tracker.done and m.stopped and m.success
     assert m.path_length == pytest.approx(3.25)
     assert m.final_distance == pytest.approx(0.75, abs=0.06)
-    assert m.spl == pytest.approx(min(ep.geodesic_distance / 3.25, 1.0))
+    # SPL's l is the way to the success region (1 m short of the bed's face), not to the bed:
+    # measured to the bed (4.0 m) this 3.25 m run would score SPL 1, shorter than "shortest"
+    assert ep.geodesic_distance == pytest.approx(4.0, abs=0.06)
+    assert m.shortest_to_success == pytest.approx(ep.geodesic_distance - 1.0, abs=0.06)
+    assert m.spl == pytest.approx(m.shortest_to_success / 3.25) and m.spl < 0.95
