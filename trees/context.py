@@ -89,6 +89,11 @@ class MissionContext:
     spent_viewpoints: list[tuple[float, float]] = field(default_factory=list)
     # centroids of spent frontiers Explore drove into (``push_through``): one push per spot
     pushed_frontiers: list[tuple[float, float]] = field(default_factory=list)
+    # frontier ids whose goal failed (no path, or no progress): picking one again is no progress
+    # for the idle clock, so a retried Explore that only finds those fails instead of idling anew
+    failed_frontiers: set[int] = field(default_factory=set)
+    # centroids of failed frontiers Explore tried once more on the squeeze mask (``squeeze``)
+    squeezed_frontiers: list[tuple[float, float]] = field(default_factory=list)
     # quarter turns in place done at the mission's start (Explore's start_look_turns); shared by
     # every Explore instance, so the look-around happens once per mission
     start_looks: int = 0

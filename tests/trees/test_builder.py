@@ -78,7 +78,8 @@ def test_defaults_fill_missing_optional_parameters(tmp_path: Path):
     assert definition.root.params == {"max_idle_s": 2, "goal_tolerance": 0.3, "switch_distance": 0.5, "look_turns": 4,
                                       "spent_radius": 0.4, "spent_after_s": 0.5,
                                       "start_look_turns": 0, "push_through": True, "push_radius": 1.5,
-                                      "push_m": 0.6, "push_s": 6.0, "stall_s": 8.0}
+                                      "push_m": 0.6, "push_s": 6.0, "stall_s": 8.0,
+                                      "squeeze": True}
 
 
 def test_user_behaviour_by_import_path(tmp_path: Path):

@@ -207,6 +207,27 @@ def test_verify_rejects_a_candidate_rarely_detected_while_in_view(tmp_path):
     assert 3 in ctx.rejected
 
 
+def test_verify_rejects_a_candidate_seen_in_none_of_the_first_frames_without_glancing_on(tmp_path):
+    """A spurious box is not there again: 0 detections in ``unseen_view_frames`` frames in view
+    rejects it at once, not after ``max_view_frames`` (glancing on cost Gibson Newfields/0/1 180
+    of its 500 steps); one detection among them keeps the full test running."""
+    ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 8, unseen_view_frames: 4")
+    tree.tick()
+    statuses = []
+    for aid in range(2, 6):
+        _view(ctx, aid, False)
+        statuses.append(tree.tick())
+    assert statuses == [S.RUNNING] * 3 + [S.FAILURE]
+    assert "0 of 4 frames" in ctx.rejections[-1][1] and 3 in ctx.rejected
+    ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 8, unseen_view_frames: 4")
+    tree.tick()
+    for aid in range(2, 9):
+        _view(ctx, aid, aid == 3)
+        assert tree.tick() == S.RUNNING  # 1 of up to 7 frames: still judged on the full 8
+    _view(ctx, 9, False)
+    assert tree.tick() == S.FAILURE and "1 of 8 frames" in ctx.rejections[-1][1]
+
+
 def test_verify_does_not_count_frames_with_a_wall_between_camera_and_candidate(tmp_path):
     """Gibson Wainscott/0/2: a real plant behind a corner of a scanned wall was rejected as
     "detected in 0 of 8 frames in view"; a wall on the map (an occupied cell no memory object
@@ -537,7 +558,8 @@ def test_approach_cell_on_a_settle_ring_is_the_one_nearest_the_object():
     assert approach_cell(grid, lo, hi, robot, 0.8) is None
     plain = approach_cell(grid, lo, hi, robot, 1.0)
     near = approach_cell(grid, lo, hi, robot, 1.0, box_weight=4.0)
-    d = lambda c: float(np.hypot(max(lo[0] - c[0], 0, c[0] - hi[0]), max(lo[1] - c[1], 0, c[1] - hi[1])))
+    def d(c):
+        return float(np.hypot(max(lo[0] - c[0], 0, c[0] - hi[0]), max(lo[1] - c[1], 0, c[1] - hi[1])))
     assert d(plain) > 0.9  # the ring's edge, toward the robot
     assert d(near) < 0.87
 
@@ -855,3 +877,84 @@ def test_explore_skips_a_frontier_it_comes_no_nearer_to(tmp_path):
     tree.tick()
     assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.ref_id == 1
     assert any("no progress" in e for e in ctx.events)
+
+
+def _fail_last_goal(ctx) -> object:
+    """Report the newest goal request as failed (no path); returns its goal."""
+    last = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    ctx.nav = NavStatus(last.seq, "failed", 0.0)
+    return last.goal
+
+
+def test_explore_squeezes_once_toward_each_failed_frontier_before_it_gives_up(tmp_path):
+    """Gibson Onaga/0/1: every frontier failed on the map's masks (its grid phase closed the one
+    passage) and the mission idled to its end. With nothing left, each failed frontier is tried
+    once more as a goal through unknown floor (the navigator's squeeze), then Explore fails."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = _plan_at(0.0, (0, (8.0, 8.0)), (1, (1.0, 8.0)))
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {max_idle_s: 3}\n"), ctx)
+    goals = []
+    for _ in range(4):  # two ordinary goals, then two squeezes: all fail at once
+        tree.tick()
+        goals.append(_fail_last_goal(ctx))
+        clock.t += 0.1
+    assert [(g.ref_id, g.through_unknown) for g in goals] == [(0, False), (1, False), (0, True), (1, True)]
+    assert any("squeezing toward frontier #0" in e for e in ctx.events)
+    status = S.RUNNING
+    while status == S.RUNNING and clock.t < 5.0:
+        status = tree.tick()
+        clock.t += 0.5
+    assert status == S.FAILURE
+    assert [m.goal.through_unknown for m in ctx.outbox if isinstance(m, GoalMsg) and m.goal is not None].count(True) == 2
+
+
+def test_a_retried_explore_does_not_idle_anew_for_frontiers_that_failed_before(tmp_path):
+    """Re-picking an unreachable frontier reset the idle clock on every retry: Onaga/0/1 spent
+    430 s of clock without a step. A frontier that failed once is no progress when picked again."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    ctx.plan = _plan_at(0.0, (0, (8.0, 8.0)))
+    tree = MissionTree(_write(tmp_path, "root:\n  Retry:\n    num_failures: 50\n    child:\n"
+                                        "      Explore: {max_idle_s: 3, squeeze: false}\n"), ctx)
+    tree.tick()
+    _fail_last_goal(ctx)
+    status, ticks = S.RUNNING, 0
+    while status == S.RUNNING:
+        clock.t += 0.1
+        status = tree.tick()
+        if [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal is not None:
+            _fail_last_goal(ctx)
+        ticks += 1
+        assert ticks < 400
+    assert status == S.FAILURE and clock.t < 3.0 + 0.1 * 200  # not 50 x 3 s of idling
+
+
+def test_verify_gives_a_candidate_observed_often_the_full_frame_count(tmp_path):
+    """Gibson Onaga/0/1: a real plant seen 17 times went undetected in 4 frames from 0.8 m and the
+    early rejection (meant for spurious boxes, seen once or twice) threw it away."""
+    ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 8, unseen_view_frames: 4")
+    ctx.world = world(FACING_BED, [obj(3, "bed", 5.0, 5.0, n_obs=17)], anchors=[anchor(1, FACING_BED, (3,))])
+    tree.tick()
+    for aid in range(2, 9):
+        ctx.world = world(FACING_BED, [obj(3, "bed", 5.0, 5.0, n_obs=17)], anchors=[anchor(aid, FACING_BED)])
+        assert tree.tick() == S.RUNNING  # 0 of up to 7 frames: judged on the full 8
+    ctx.world = world(FACING_BED, [obj(3, "bed", 5.0, 5.0, n_obs=17)], anchors=[anchor(9, FACING_BED)])
+    assert tree.tick() == S.FAILURE and "0 of 8 frames" in ctx.rejections[-1][1]
+
+
+@pytest.mark.parametrize("n_obs, confirmed", [(31, True), (3, False)])
+def test_verify_accepts_a_low_scored_candidate_observed_many_times(tmp_path, n_obs, confirmed):
+    """The oracle scores a small plant low in every frame: seen 31 times at 0.29 it was rejected
+    for its score (Gibson Onaga/0/1). ``confident_observations`` observations pass the gate."""
+    ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, min_confidence: 0.3")
+    bed = obj(3, "bed", 5.0, 5.0, n_obs=n_obs, conf=0.29)
+    ctx.world = world(FACING_BED, [bed], anchors=[anchor(1, FACING_BED, (3,))])
+    tree.tick()
+    for aid in (2, 3):
+        ctx.world = world(FACING_BED, [bed], anchors=[anchor(aid, FACING_BED, (3,))])
+        status = tree.tick()
+    assert (status == S.SUCCESS) == confirmed
+    if not confirmed:
+        assert "confidence 0.29" in ctx.rejections[-1][1]
+
