@@ -109,6 +109,12 @@ class Explore(MissionBehaviour):
     toilet opened at the robot's side, below the camera's view, and the mission ended with "no
     frontier left" after 33 of 500 steps).
 
+    A frontier whose goal failed (no path, or no progress for ``stall_s``) is remembered for the
+    mission (``context.failed_frontiers``): picking it again is no progress for the idle clock, so
+    a retried Explore over unreachable frontiers fails instead of idling anew. With every frontier
+    failed, each is tried once more (``squeeze``) as a goal through unknown floor, where the
+    navigator falls back to the lethal layer one cell thinner.
+
     ``start_look_turns`` quarter turns in place come first, once per mission (the count lives in
     the context, so a retried Explore goes on where a preempted one stopped): the camera sees 79
     degrees, so without them the start room is only known in the direction the robot happened to
