@@ -419,6 +419,7 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
         error_kind="runtime" if result.failure else None,
         extra={"mission": result.mission_status, "fallbacks": result.fallbacks,
                "feedback": result.mission_feedback,
+               "shortest_to_success": float(m.shortest_to_success),  # SPL's l (docs/evaluation.md)
                "dropped": {k: dict(v.dropped) for k, v in result.stats.items() if v.dropped}})
 
 

@@ -149,6 +149,8 @@ def test_eval_runner_entry_point_returns_an_episode_record(shared_data, embedder
     assert record.steps <= 12 and record.max_steps == 12
     assert record.detector == "oracle" and record.reasoner == "offline"
     assert set(record.layer_frames) >= {"driver", "perception", "memory", "mission", "control"}
+    # SPL's l: the way to the success region, shorter than the way to the sofa itself
+    assert 0.0 < record.extra["shortest_to_success"] < record.geodesic_distance
 
 
 def test_stepped_offline_reasoning_takes_no_measured_wall_time(house, episodes, embedder):
