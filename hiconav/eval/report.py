@@ -78,8 +78,10 @@ def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
                      ", ".join(group["detectors"]) or "-", ", ".join(group["reasoners"]) or "-"])
     lines += _table(["Preset", "Method", "Episodes", "Valid", "SR (%)", "SPL (%)", "DTS (m)",
                      "Detector", "Reasoner"], rows)
-    lines += [("SR and SPL over valid episodes (invalid input is counted but not run); DTS is the mean "
-               "geodesic distance to the success region at the end."), ""]
+    lines += [("SR and SPL over valid episodes (invalid input is counted but not run); SPL's shortest path "
+               "is the geodesic distance from the start to the success region (runs recorded before "
+               "December 2026 measured it to the goal object; `python -m hiconav.eval.rescore OUT` "
+               "rescores them); DTS is the mean geodesic distance to the success region at the end."), ""]
 
     ablations: dict[str, dict[str, Any]] = summary.get("ablations", {})
     lines += ["## Ablations", ""]
