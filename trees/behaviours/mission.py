@@ -315,7 +315,7 @@ class Explore(MissionBehaviour):
             return Status.RUNNING  # a push runs to its end: the frontier it enters changes as it goes
         if self._squeezing and self._seq is not None:
             self.feedback_message = f"squeezing toward frontier #{self._frontier}"
-            return Status.RUNNING  # the idle clock moves on while it is "active" only (above)
+            return Status.RUNNING  # progress (0.25 m nearer, above) alone resets the idle clock
         self._squeezing = False
         pick = self._pick()
         if pick is None:
@@ -717,9 +717,9 @@ class VerifyTarget(_GoToObject):
             # a sequential test: a real object is detected in most frames that show it (a miss
             # rate of 0.3 leaves it undetected in 4 frames 1% of the time), a spurious box almost
             # never twice; glancing on to 8 frames at a candidate seen in none cost Gibson's
-            # large floors ~60 steps a rejection, 180 of Newfields/0/1's 500
-            # ... for a candidate observed once or twice: a real plant seen 17 times went undetected in 4
-            # frames from 0.8 m (its box a sliver of its front face; Gibson Onaga/0/1)
+            # large floors ~60 steps a rejection, 180 of Newfields/0/1's 500. Only for candidates
+            # observed once or twice: a real plant seen 17 times went undetected in 4 frames from
+            # 0.8 m, its box a sliver of its front face (Gibson Onaga/0/1)
             unseen = fresh == 0 and frames >= self.param("unseen_view_frames") and \
                 int(obj.n_obs) <= self.param("unseen_max_observations")
             if frames >= self.param("max_view_frames") or unseen:
