@@ -11,11 +11,13 @@ without running them again. It reads files only and changes nothing.
 from __future__ import annotations
 
 import argparse
+import sys
 from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
 
+from hiconav.errors import DataError
 from hiconav.eval.records import read_records
 from hiconav.eval.sources import read_specs
 from hiconav.sim.config import SimConfig
@@ -47,7 +49,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("out", nargs="+", type=Path, help="output folders of hiconav eval")
     args = ap.parse_args(argv)
     for out in args.out:
-        for preset, (n, sr, old, new) in rescore(out).items():
+        try:
+            scores = rescore(out)
+        except DataError as exc:  # a missing or malformed specs.jsonl / episodes.jsonl: say which
+            print(f"hiconav.eval.rescore: {exc}", file=sys.stderr)
+            return 2
+        for preset, (n, sr, old, new) in scores.items():
             print(f"{out} {preset}: {n} episodes  SR {sr:.3f}  SPL recorded {old:.3f}  SPL to the success region {new:.3f}")
     return 0
 

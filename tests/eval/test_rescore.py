@@ -31,3 +31,8 @@ def test_a_run_scored_against_the_object_distance_is_rescored_to_the_success_reg
     assert new == pytest.approx(0.5 * l_s / l_obj)
     assert main([str(tmp_path)]) == 0
     assert "SPL to the success region" in capsys.readouterr().out
+
+
+def test_a_folder_without_a_run_is_refused_with_the_file_named(tmp_path, capsys) -> None:
+    assert main([str(tmp_path / "nothing")]) == 2
+    assert "specs.jsonl" in capsys.readouterr().err
