@@ -27,7 +27,8 @@ from hiconav.sim.metrics import spl
 
 def rescore(out: Path, success_distance: float | None = None) -> dict[str, tuple[int, float, float, float]]:
     """{preset: (episodes, SR, SPL as recorded, SPL to the success region)} over valid episodes."""
-    dist = SimConfig().success_distance if success_distance is None else float(success_distance)
+    sim = SimConfig()  # the simulator's robot radius and success distance, as the runs used them
+    dist = sim.success_distance if success_distance is None else float(success_distance)
     specs = {s.episode_id: s for s in read_specs(out / "specs.jsonl")}
     acc: dict[str, list[tuple[bool, float, float]]] = defaultdict(list)
     for r in read_records(out / "episodes.jsonl"):
@@ -36,7 +37,8 @@ def rescore(out: Path, success_distance: float | None = None) -> dict[str, tuple
         new = 0.0
         if r.success:
             spec = specs[r.episode_id]
-            goal = GoalDistance(spec.load_house(), instance_ids=list(spec.goal_instance_ids))
+            goal = GoalDistance(spec.load_house(), instance_ids=list(spec.goal_instance_ids),
+                                radius=sim.robot_radius)
             l_s = goal.to_success(np.asarray(spec.start[:2], dtype=np.float64), dist)
             new = spl(True, l_s, r.path_length)
         acc[r.preset].append((bool(r.success), float(r.spl), new))

@@ -353,7 +353,7 @@ class Navigator:
             return self._step_straight(grid, pose)
         # stuck detection: a forward step that did not move the robot
         if self._last_action == DiscreteAction.MOVE_FORWARD and self._last_pose is not None:
-            if self._last_pose.distance_to(pose) < cfg.stuck_progress_m:
+            if self._forward_blocked(pose):
                 self._stuck += 1
                 self._add_virtual_obstacle(pose)
                 self.path_xy = None  # force a re-plan around the new obstacle
@@ -390,6 +390,12 @@ class Navigator:
             target = self.path_xy[-1]
         return self._act(self._discrete_action(grid, pose, target), pose)
 
+    def _forward_blocked(self, pose: Pose2D) -> bool:
+        """True when the last action was a forward step that moved the robot less than
+        ``stuck_progress_m`` (to ``pose``): something the map may not know is in the way."""
+        return self._last_action == DiscreteAction.MOVE_FORWARD and self._last_pose is not None \
+            and self._last_pose.distance_to(pose) < self.config.stuck_progress_m
+
     def _step_straight(self, grid: GridLike, pose: Pose2D) -> DiscreteAction:
         """A ``Goal.straight`` step: face the goal and step forward, no plan; done (facing the
         goal's yaw) within its tolerance, within half a step of it, when a forward step was blocked
@@ -403,8 +409,7 @@ class Navigator:
         goal = self.goal
         assert goal is not None
         step = cfg.discrete.forward_step_m
-        blocked = self._last_action == DiscreteAction.MOVE_FORWARD and self._last_pose is not None \
-            and self._last_pose.distance_to(pose) < cfg.stuck_progress_m
+        blocked = self._forward_blocked(pose)
         d = float(np.hypot(*(goal.xy - pose.xy)))
         heading = math.atan2(goal.y - pose.y, goal.x - pose.x)
         done = self.reached or blocked or d <= max(goal.tolerance, 0.5 * step)

@@ -174,9 +174,14 @@ class Explore(MissionBehaviour):
         self.feedback_message = f"looking around the start ({ctx.start_looks}/{self.param('start_look_turns')})"
         return Status.RUNNING
 
-    def _spent(self, xy: np.ndarray) -> bool:
+    def _near_any(self, xy: np.ndarray, spots: list[tuple[float, float]]) -> bool:
+        """True when ``xy`` lies within ``spent_radius`` of one of ``spots`` (spent viewpoints,
+        pushed or squeezed frontier centroids: one visit per spot, whatever id the plan gives it)."""
         r = self.param("spent_radius")
-        return any(math.hypot(xy[0] - sx, xy[1] - sy) <= r for sx, sy in self.context.spent_viewpoints)
+        return any(math.hypot(xy[0] - x, xy[1] - y) <= r for x, y in spots)
+
+    def _spent(self, xy: np.ndarray) -> bool:
+        return self._near_any(xy, self.context.spent_viewpoints)
 
     def _settle_reached(self) -> None:
         """Mark reached viewpoints as spent once a plan made after the visit still shows a
@@ -205,9 +210,7 @@ class Explore(MissionBehaviour):
         robot = np.array([pose.x, pose.y])
         d = centroid - robot
         dist = float(np.hypot(*d))
-        r = self.param("spent_radius")
-        if dist > self.param("push_radius") or any(math.hypot(centroid[0] - px, centroid[1] - py) <= r
-                                                   for px, py in self.context.pushed_frontiers):
+        if dist > self.param("push_radius") or self._near_any(centroid, self.context.pushed_frontiers):
             return None
         yaw = math.atan2(d[1], d[0]) if dist > 0.1 else pose.yaw
         goal = centroid + self.param("push_m") * np.array([math.cos(yaw), math.sin(yaw)])
@@ -237,13 +240,12 @@ class Explore(MissionBehaviour):
         if msg is None or not self.param("squeeze"):
             return None
         frontiers = {f.id: f for f in msg.frontiers}
-        r = self.param("spent_radius")
         for fid in list(getattr(msg.plan, "order", ()) or ()):
             f = frontiers.get(fid)
             if f is None or fid not in self.context.failed_frontiers:
                 continue
             centroid = np.asarray(f.centroid, dtype=np.float64)
-            if any(math.hypot(centroid[0] - x, centroid[1] - y) <= r for x, y in self.context.squeezed_frontiers):
+            if self._near_any(centroid, self.context.squeezed_frontiers):
                 continue
             self.context.squeezed_frontiers.append((float(centroid[0]), float(centroid[1])))
             xy = np.asarray(f.viewpoint, dtype=np.float64)
