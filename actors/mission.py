@@ -49,7 +49,7 @@ class MissionNode(Node):
     def __init__(self, tree: str | Path, instruction: str, *, rate_hz: float = 10.0,
                  blackboard: dict[str, Any] | None = None, success_distance: float = 1.0, verify: bool = True,
                  use_memory_labels: bool = True, record_tree: bool = False,
-                 requalify_observations: int = 3) -> None:
+                 requalify_observations: int = 3, remap_area_m2: float = 1.0) -> None:
         super().__init__(rate_hz)
         self.tree_source = tree
         self.instruction = instruction
@@ -58,6 +58,7 @@ class MissionNode(Node):
         self.verify = verify
         self.use_memory_labels = use_memory_labels
         self.requalify_observations = requalify_observations
+        self.remap_area_m2 = remap_area_m2
         self.record_tree = record_tree
         self._now = 0.0
         self.context: MissionContext | None = None
@@ -84,7 +85,8 @@ class MissionNode(Node):
         self.context = MissionContext(instruction=self.instruction, clock=lambda: self._now,
                                       success_distance=self.success_distance, verify=self.verify,
                                       use_memory_labels=self.use_memory_labels,
-                                      requalify_observations=self.requalify_observations)
+                                      requalify_observations=self.requalify_observations,
+                                      remap_area_m2=self.remap_area_m2)
         self.tree = MissionTree(self.tree_source, self.context, self.blackboard)
 
     def stop(self, now: float) -> None:

@@ -71,6 +71,9 @@ class MissionConfig(BaseModel):
     # a candidate deferred for a label flip is due again after this many new observations under a
     # target label (0: only when its deferral time runs out)
     requalify_observations: int = Field(3, ge=0)
+    # a candidate deferred for want of a reachable view or approach cell is due again once the known
+    # free floor within 2 m of it has grown by this much (0: only when its deferral time runs out)
+    remap_area_m2: float = Field(1.0, ge=0)
     # stepped: a reply becomes visible after this (None: the measured latency of a VLM; the offline
     # reasoner then counts as instantaneous so that same-seed runs stay identical)
     vlm_latency_s: float | None = Field(None, ge=0)
@@ -210,7 +213,8 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     mission = MissionNode(tree or cfg.tree, instruction, rate_hz=rates.mission,
                           success_distance=sim_cfg.success_distance, verify=cfg.verify,
                           use_memory_labels=cfg.use_memory_labels,
-                          requalify_observations=cfg.requalify_observations, record_tree=record is not None or spawn)
+                          requalify_observations=cfg.requalify_observations,
+                          remap_area_m2=cfg.remap_area_m2, record_tree=record is not None or spawn)
     nodes = [driver, perception, memory, reasoning, exploration, control, mission]
     for path, kwargs in cfg.extra_actors.items():
         from hiconav.actors.node import Node

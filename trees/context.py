@@ -72,6 +72,14 @@ class MissionContext:
     # since seen ``requalify_observations`` more times under a target label is due at once
     deferred_obs: dict[int, int] = field(default_factory=dict)
     requalify_observations: int = 3  # 0: never (a deferral lasts its time)
+    # object id -> (window min xy, window max xy, known-free m^2 in it when deferred): a candidate
+    # deferred for want of a reachable cell on the map is due again once the map around it has
+    # grown by ``remap_area_m2`` (``reject(remap=True)``)
+    deferred_map: dict[int, tuple[np.ndarray, np.ndarray, float]] = field(default_factory=dict)
+    remap_area_m2: float = 1.0  # 0: never (a deferral lasts its time)
+    remap_margin_m: float = 2.0  # the window is the candidate's footprint grown by this
+    remaps: dict[int, int] = field(default_factory=dict)  # object id -> map deferrals so far
+    max_remaps: int = 3  # map deferrals per candidate; later ones last their time
     rejections: list[tuple[int, str]] = field(default_factory=list)  # every rejection/deferral, in order
     start_pose: Pose2D | None = None
     outbox: list[Any] = field(default_factory=list)
@@ -151,6 +159,14 @@ class MissionContext:
             return True
         if self.deferred.get(object_id, -1.0) <= self.now():
             return False
+        window = self.deferred_map.get(object_id)
+        if window is not None and self.remap_area_m2 > 0:
+            grown = self.free_area_m2(window[0], window[1]) - window[2]
+            if grown >= self.remap_area_m2:
+                self.log(f"deferral of #{object_id} lapsed: the map around it grew by {grown:.1f} m^2")
+                del self.deferred[object_id]
+                del self.deferred_map[object_id]
+                return False
         base = self.deferred_obs.get(object_id)
         if base is None or self.task is None or not self.requalify_observations:
             return True
@@ -162,9 +178,10 @@ class MissionContext:
         return True
 
     def reject(self, object_id: int, reason: str, *, permanent: bool = True, defer_s: float = 30.0,
-               requalify: bool = False) -> None:
+               requalify: bool = False, remap: bool = False) -> None:
         """Verification failed: exclude the candidate for good, or for ``defer_s`` clock seconds
-        (with ``requalify``, or until it is observed again as a target: see ``excluded``)."""
+        (with ``requalify``, or until it is observed again as a target; with ``remap``, or until
+        the map around it has grown: see ``excluded``)."""
         if permanent:
             self.rejected.add(object_id)
         else:
@@ -174,8 +191,30 @@ class MissionContext:
                 self.deferred_obs[object_id] = int(obj.n_obs)
             else:
                 self.deferred_obs.pop(object_id, None)
+            obj = self.object(object_id) if remap else None
+            if obj is not None and self.grid is not None:
+                lo = np.asarray(obj.box_min, dtype=np.float64)[:2] - self.remap_margin_m
+                hi = np.asarray(obj.box_max, dtype=np.float64)[:2] + self.remap_margin_m
+                self.deferred_map[object_id] = (lo, hi, self.free_area_m2(lo, hi))
+                self.remaps[object_id] = self.remaps.get(object_id, 0) + 1
+            else:
+                self.deferred_map.pop(object_id, None)
         self.rejections.append((object_id, reason))
         self.log(f"{'rejected' if permanent else 'deferred'} #{object_id}: {reason}")
+
+    def free_area_m2(self, lo: np.ndarray, hi: np.ndarray) -> float:
+        """Known-free floor (m^2) of the current grid inside the world window [lo, hi] (xy)."""
+        grid = self.grid
+        if grid is None:
+            return 0.0
+        state, res = np.asarray(grid.state), float(grid.resolution)
+        origin = np.asarray(grid.origin, dtype=np.float64)
+        c0, r0 = np.floor((np.asarray(lo, dtype=np.float64) - origin) / res).astype(int)
+        c1, r1 = np.floor((np.asarray(hi, dtype=np.float64) - origin) / res).astype(int) + 1
+        r0, c0, r1, c1 = max(r0, 0), max(c0, 0), min(r1, state.shape[0]), min(c1, state.shape[1])
+        if r0 >= r1 or c0 >= c1:
+            return 0.0
+        return float(np.count_nonzero(state[r0:r1, c0:c1] == 0)) * res ** 2
 
     def log(self, text: str) -> None:
         self.events.append(f"{self.now():.2f} {text}")

@@ -958,3 +958,60 @@ def test_verify_accepts_a_low_scored_candidate_observed_many_times(tmp_path, n_o
     if not confirmed:
         assert "confidence 0.29" in ctx.rejections[-1][1]
 
+
+
+def _unknown_room() -> "object":
+    """The open 10 m room with everything beyond x = 3 m still unknown."""
+    from .fakes import open_grid
+
+    grid = open_grid()
+    grid.state[:, 30:] = -1
+    return grid
+
+
+def test_a_no_view_point_deferral_lapses_once_the_map_around_the_candidate_grows(tmp_path):
+    """Gibson Leonardo/0/2: judged on the first frames' map, a plant 4 m off had no reachable view
+    cell, and its 30 s deferral sent the robot 39 m about the house, past the plant. Once the
+    known free floor within 2 m of the candidate has grown by remap_area_m2 it is due again (and
+    the deferral does not count toward max_deferrals)."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    grid = _unknown_room()
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, max_deferrals: 2}")
+    assert tree.tick() == S.FAILURE
+    assert ctx.rejections[-1] == (3, "no reachable view point") and ctx.excluded(3)
+    clock.t = 1.0
+    grid.state[40:45, 40:55] = 0  # 0.75 m^2 more free floor near the bed: not enough
+    assert ctx.excluded(3)
+    grid.state[45:48, 40:55] = 0  # 1.2 m^2 in all
+    assert not ctx.excluded(3)
+    assert any("map around it grew by 1.2 m^2" in e for e in ctx.events)
+    # a second map deferral is not the max_deferrals-th: the candidate stays deferred, not rejected
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, max_deferrals: 2}")
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
+    assert tree.tick() == S.FAILURE
+    assert 3 not in ctx.rejected and ctx.remaps[3] == 2
+
+
+def test_map_deferrals_stop_lapsing_after_max_remaps_and_remap_area_zero_disables_them():
+    clock = Clock()
+    ctx = _ctx(clock, max_remaps=1)
+    grid = _unknown_room()
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0)], grid=grid)
+    ctx.reject(3, "no reachable view point", permanent=False, defer_s=30.0, remap=True)
+    grid.state[40:60, 40:55] = 0
+    assert not ctx.excluded(3)
+    ctx.reject(3, "no reachable view point", permanent=False, defer_s=30.0,
+               remap=ctx.remaps.get(3, 0) < ctx.max_remaps)
+    grid.state[60:80, 40:55] = 0
+    assert ctx.excluded(3)  # the cap reached: this deferral lasts its time
+    clock.t = 31.0
+    assert not ctx.excluded(3)
+
+    off = _ctx(Clock(), remap_area_m2=0.0)
+    grid = _unknown_room()
+    off.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0)], grid=grid)
+    off.reject(3, "no reachable view point", permanent=False, defer_s=30.0, remap=True)
+    grid.state[40:80, 40:55] = 0
+    assert off.excluded(3)

@@ -666,13 +666,19 @@ class VerifyTarget(_GoToObject):
         return {int(o.id) for o in self.context.memory.objects if o.label in labels
                 and np.all(np.asarray(o.box_min)[:2] <= hi) and np.all(np.asarray(o.box_max)[:2] >= lo)}
 
-    def _reject(self, why: str, permanent: bool, requalify: bool = False) -> Status:
+    def _reject(self, why: str, permanent: bool, requalify: bool = False, remap: bool = False) -> Status:
         cand = self._cand
         if cand is not None:
             ctx = self.context
-            count = sum(1 for oid, _ in ctx.rejections if oid == cand.object_id) + 1
-            ctx.reject(cand.object_id, why, permanent=permanent or count >= self.param("max_deferrals"),
-                       defer_s=self.param("defer_s"), requalify=requalify)
+            oid = cand.object_id
+            # a deferral for want of a reachable view cell lapses once the map around the candidate
+            # has grown (``remap``) and does not count toward max_deferrals, up to max_remaps of them:
+            # judged on the first frames' map, a plant 4 m off had no view cell, and its 30 s
+            # deferral sent the robot 39 m about the house (Gibson Leonardo/0/2), past the plant
+            remap = remap and not permanent and ctx.remaps.get(oid, 0) < ctx.max_remaps
+            count = sum(1 for i, _ in ctx.rejections if i == oid) - ctx.remaps.get(oid, 0) + 1
+            ctx.reject(oid, why, permanent=permanent or (not remap and count >= self.param("max_deferrals")),
+                       defer_s=self.param("defer_s"), requalify=requalify, remap=remap)
         self.feedback_message = f"{'rejected' if permanent else 'deferred'}: {why}"
         return Status.FAILURE
 
@@ -758,7 +764,7 @@ class VerifyTarget(_GoToObject):
                 self._excluded.append(self._cell)
             if len(self._excluded) > 3 or not self._send(current, self._goal_distance(current)):
                 if ctx.grid is not None and ctx.pose is not None:
-                    return self._reject("no reachable view point", False)
+                    return self._reject("no reachable view point", False, remap=True)
         self.feedback_message = f"verifying {cand.label} #{cand.object_id}"
         return Status.RUNNING
 
@@ -916,7 +922,10 @@ class Approach(_GoToObject):
         return True
 
     def _give_up(self, cand: Candidate, why: str) -> Status:
-        self.context.reject(cand.object_id, f"approach: {why}", permanent=False, defer_s=self.param("defer_s"))
+        ctx = self.context
+        # no approach cell on this map: due again once the map around it has grown (as VerifyTarget)
+        remap = why == "no reachable approach cell" and ctx.remaps.get(cand.object_id, 0) < ctx.max_remaps
+        ctx.reject(cand.object_id, f"approach: {why}", permanent=False, defer_s=self.param("defer_s"), remap=remap)
         self.feedback_message = why
         return Status.FAILURE
 
