@@ -766,7 +766,9 @@ def test_approach_goes_to_its_cell_even_when_it_starts_within_the_distance(tmp_p
     (it stopped where VerifyTarget had left it, off a painting's end, in val/65/2)."""
     start = Pose2D(3.8, 4.9, math.atan2(0.1, 1.2))
     _, _, goal = _approach_bed(tmp_path, start)
-    assert goal.kind == "approach" and math.hypot(goal.x - start.x, goal.y - start.y) > 0.3
+    # to the first ring (0.55 m from the box, 4.5-5.5), 0.15 m on, in line with the bed's middle
+    assert goal.kind == "approach" and math.hypot(goal.x - start.x, goal.y - start.y) > 0.1
+    assert 4.5 - goal.x <= 0.55 + 0.05
 
 
 def test_wall_clear_sees_past_known_furniture_but_not_past_walls():
@@ -1015,3 +1017,26 @@ def test_map_deferrals_stop_lapsing_after_max_remaps_and_remap_area_zero_disable
     off.reject(3, "no reachable view point", permanent=False, defer_s=30.0, remap=True)
     grid.state[40:80, 40:55] = 0
     assert off.excluded(3)
+
+
+def test_approach_inner_margin_sets_the_first_ring_and_centre_weight_pulls_to_the_middle(tmp_path):
+    """The default mission approaches to 0.75-0.85 m (inner_margin 0.1): a first ring 0.55 m out
+    drove ~0.36 m more per success inside the 1 m success region. The bed's box spans 4.5-5.5;
+    from (1.5, 5.45) the goal is on the 0.8 m ring's edge, toward the middle (centre_weight 0.9:
+    at 1 every cell on the line to the centre ties, and the array order picked one 0.65 m out)
+    or level with the robot (centre_weight 0)."""
+    def first_goal(params: str):
+        ctx = _ctx(Clock())
+        ctx.world = world(Pose2D(1.5, 5.45, 0.0), [obj(3, "bed", 5.0, 5.0)])
+        tree = _confirmed_then(tmp_path, ctx, f"Approach: {{{params}}}")
+        assert tree.tick() == S.RUNNING
+        return [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+
+    goal = first_goal("distance: 0.9, inner_margin: 0.1")
+    assert 4.5 - goal.x == pytest.approx(0.8, abs=0.06) and goal.y < 5.45
+    flat = first_goal("distance: 0.9, inner_margin: 0.1, centre_weight: 0.0")
+    assert 4.5 - flat.x == pytest.approx(0.8, abs=0.06) and flat.y > 5.3
+    tied = first_goal("distance: 0.9, inner_margin: 0.1, centre_weight: 1.0")
+    assert 4.5 - tied.x < 0.7  # the tie: deeper than the ring's edge
+    deep = first_goal("distance: 0.9, inner_margin: 0.5")
+    assert 4.5 - deep.x == pytest.approx(0.4, abs=0.06)

@@ -390,6 +390,10 @@ class _GoToObject(MissionBehaviour):
     # approach_cell's weight on a cell's distance to the footprint's centre (see Approach)
     CENTRE_WEIGHT = 0.0
 
+    def _centre_weight(self) -> float:
+        """approach_cell's weight on a cell's distance to the footprint's centre (see Approach)."""
+        return self.CENTRE_WEIGHT
+
     def _prefer_weight(self) -> float:
         """approach_cell's weight on a cell's distance to ``_preferred_xy`` (see VerifyTarget)."""
         return 0.0
@@ -412,7 +416,7 @@ class _GoToObject(MissionBehaviour):
         memory = ctx.memory
         furniture = [(np.asarray(o.box_min), np.asarray(o.box_max)) for o in getattr(memory, "objects", ())
                      if int(o.id) != int(cand.object_id)]
-        kw = {"centre_weight": self.CENTRE_WEIGHT, "prefer_xy": prefer, "prefer_weight": self._prefer_weight(),
+        kw = {"centre_weight": self._centre_weight(), "prefer_xy": prefer, "prefer_weight": self._prefer_weight(),
               "sight": self._sight(cand), "furniture": furniture, "strict_walls": strict_walls,
               "box_weight": box_weight}
         cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, **kw)
@@ -778,11 +782,13 @@ class Approach(_GoToObject):
     it, or show a better candidate) instead of picking the same unreachable object again.
     """
 
-    # 1 m nearer the footprint's centre is worth 1 m more to drive: the robot stops in front of
-    # the object's middle, not off one of its ends (VerifyTarget keeps 0: pulled to the centre,
-    # its cells came nearer than the camera's minimum depth, where detections have no 3D points
-    # and no view counts; ProcTHOR val/2/0 rejected a real dresser so)
-    CENTRE_WEIGHT = 1.0
+    # centre_weight (1 m nearer the footprint's centre is worth 0.9 m more to drive): the robot
+    # stops in front of the object's middle, not off one of its ends. Below 1, so that of the
+    # cells on the line from the robot to the centre the nearest wins: at exactly 1 they all
+    # cost the same and the array order picked one up to the ring's inner edge, a drive of
+    # ~0.3 m more per success inside the success region (VerifyTarget keeps 0:
+    # pulled to the centre, its cells came nearer than the camera's minimum depth, where
+    # detections have no 3D points and no view counts; ProcTHOR val/2/0 rejected a real dresser so)
     # on a ring wider than ``distance``, 1 m nearer the object's box is worth 4 m more to drive
     SETTLE_BOX_WEIGHT = 4.0
     # clock seconds a creep may take (a few steps; blocked by clutter it would rock on)
@@ -798,9 +804,17 @@ class Approach(_GoToObject):
         "defer_s": Param(float, 30.0, minimum=0.0, maximum=3600.0, doc="an unreachable candidate waits this long"),
         "arrive_radius": Param(float, 0.3, minimum=0.0, maximum=5.0,
                                doc="done only this near the approach cell (when one was sent)"),
+        "centre_weight": Param(float, 0.9, minimum=0.0, maximum=100.0,
+                               doc="1 m nearer the footprint's centre is worth this many m more to drive "
+                                   "(below 1: of the cells in line with the centre, the nearest)"),
+        "inner_margin": Param(float, 0.25, minimum=0.0, maximum=5.0,
+                              doc="the first ring tried lies this far inside the distance"),
         "creep": Param(bool, True, doc="settled beyond the distance: creep toward the object through "
                                        "floor the map does not know before stopping"),
     }
+
+    def _centre_weight(self) -> float:
+        return self.param("centre_weight")
 
     def initialise(self) -> None:
         self._start = self.context.now()
@@ -858,7 +872,8 @@ class Approach(_GoToObject):
             distance = self.param("distance")
             # aim well inside the distance first; near walls and furniture the inflated map may only
             # have free cells farther out, so widen the ring up to the distance itself
-            rings = [max(distance - 0.25, 0.2), max(distance - 0.1, 0.2), distance]
+            inner = self.param("inner_margin")
+            rings = sorted({max(distance - inner, 0.2), max(distance - min(inner, 0.1), 0.2), distance})
             # furniture in front of the target (a sofa under a wall-mounted tv) can leave no free cell
             # within the distance: then settle for the closest ring that has one, up to max_distance,
             # and stop there rather than give up (the success check is the judge, not this estimate)
