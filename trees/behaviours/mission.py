@@ -461,7 +461,9 @@ class VerifyTarget(_GoToObject):
     (a false positive); one whose label changed or whose confidence is low (unless observed
     ``confident_observations`` times), or that cannot be
     reached or re-observed in time, is deferred for ``defer_s`` (rejected for good after
-    ``max_deferrals``), so exploration resumes.
+    ``max_deferrals``), so exploration resumes. One with no reachable view cell on the map is
+    due again as soon as the map around it has grown (``MissionContext.remap_area_m2``, up to
+    ``max_remaps`` times; these deferrals do not count toward ``max_deferrals``).
 
     Fresh views count only target-labelled nodes whose box overlaps the candidate's (grown by
     ``support_margin``): counting every same-label node within a radius let spurious boxes cast
@@ -778,7 +780,8 @@ class Approach(_GoToObject):
     """Reach a free cell within ``distance`` of the target's footprint, facing it.
 
     When no approach cell is reachable or time runs out, the candidate is deferred for
-    ``defer_s`` before FAILURE, so that a Retry above explores on (the map may yet open a way to
+    ``defer_s`` (an unreachable one until the map around it has grown, as in VerifyTarget)
+    before FAILURE, so that a Retry above explores on (the map may yet open a way to
     it, or show a better candidate) instead of picking the same unreachable object again.
     """
 
