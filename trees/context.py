@@ -180,8 +180,8 @@ class MissionContext:
     def reject(self, object_id: int, reason: str, *, permanent: bool = True, defer_s: float = 30.0,
                requalify: bool = False, remap: bool = False) -> None:
         """Verification failed: exclude the candidate for good, or for ``defer_s`` clock seconds
-        (with ``requalify``, or until it is observed again as a target; with ``remap``, or until
-        the map around it has grown: see ``excluded``)."""
+        (with ``requalify``, or until it is observed again as a target; with ``remap``, while
+        ``can_remap``, or until the map around it has grown: see ``excluded``)."""
         if permanent:
             self.rejected.add(object_id)
         else:
@@ -191,7 +191,7 @@ class MissionContext:
                 self.deferred_obs[object_id] = int(obj.n_obs)
             else:
                 self.deferred_obs.pop(object_id, None)
-            obj = self.object(object_id) if remap else None
+            obj = self.object(object_id) if remap and self.can_remap(object_id) else None
             if obj is not None and self.grid is not None:
                 lo = np.asarray(obj.box_min, dtype=np.float64)[:2] - self.remap_margin_m
                 hi = np.asarray(obj.box_max, dtype=np.float64)[:2] + self.remap_margin_m
@@ -201,6 +201,10 @@ class MissionContext:
                 self.deferred_map.pop(object_id, None)
         self.rejections.append((object_id, reason))
         self.log(f"{'rejected' if permanent else 'deferred'} #{object_id}: {reason}")
+
+    def can_remap(self, object_id: int) -> bool:
+        """A deferral of ``object_id`` may still lapse on map growth (fewer than ``max_remaps`` did)."""
+        return self.remaps.get(object_id, 0) < self.max_remaps
 
     def free_area_m2(self, lo: np.ndarray, hi: np.ndarray) -> float:
         """Known-free floor (m^2) of the current grid inside the world window [lo, hi] (xy)."""

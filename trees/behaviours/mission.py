@@ -387,12 +387,9 @@ class _GoToObject(MissionBehaviour):
     """Shared machinery: choose a free cell near the candidate's footprint and go there facing it."""
 
     READS = ("target",)
-    # approach_cell's weight on a cell's distance to the footprint's centre (see Approach)
-    CENTRE_WEIGHT = 0.0
-
     def _centre_weight(self) -> float:
         """approach_cell's weight on a cell's distance to the footprint's centre (see Approach)."""
-        return self.CENTRE_WEIGHT
+        return 0.0
 
     def _prefer_weight(self) -> float:
         """approach_cell's weight on a cell's distance to ``_preferred_xy`` (see VerifyTarget)."""
@@ -681,7 +678,7 @@ class VerifyTarget(_GoToObject):
             # has grown (``remap``) and does not count toward max_deferrals, up to max_remaps of them:
             # judged on the first frames' map, a plant 4 m off had no view cell, and its 30 s
             # deferral sent the robot 39 m about the house (Gibson Leonardo/0/2), past the plant
-            remap = remap and not permanent and ctx.remaps.get(oid, 0) < ctx.max_remaps
+            remap = remap and not permanent and ctx.can_remap(oid)
             count = sum(1 for i, _ in ctx.rejections if i == oid) - ctx.remaps.get(oid, 0) + 1
             ctx.reject(oid, why, permanent=permanent or (not remap and count >= self.param("max_deferrals")),
                        defer_s=self.param("defer_s"), requalify=requalify, remap=remap)
@@ -940,10 +937,9 @@ class Approach(_GoToObject):
         return True
 
     def _give_up(self, cand: Candidate, why: str) -> Status:
-        ctx = self.context
         # no approach cell on this map: due again once the map around it has grown (as VerifyTarget)
-        remap = why == "no reachable approach cell" and ctx.remaps.get(cand.object_id, 0) < ctx.max_remaps
-        ctx.reject(cand.object_id, f"approach: {why}", permanent=False, defer_s=self.param("defer_s"), remap=remap)
+        self.context.reject(cand.object_id, f"approach: {why}", permanent=False, defer_s=self.param("defer_s"),
+                            remap=why == "no reachable approach cell")
         self.feedback_message = why
         return Status.FAILURE
 
