@@ -538,6 +538,31 @@ def test_approach_cell_prefers_the_front_of_an_objects_middle_over_its_near_end(
     assert abs(centred[1] - 4.5) < 0.45 and centred[0] > 4.1  # in front of the middle, within 0.8 m
 
 
+def test_approach_cell_judges_walls_at_the_cameras_height_when_told_it():
+    """Gibson Leonardo/0/0: the robot stood 0.67 m from a sofa, but an unlabelled 0.8 m cabinet
+    at the sofa's end lay on the line to its centre, so every cell there counted as behind a
+    wall and it drove 1.2 m to the sofa's middle. With the camera's height (0.88 m) and the
+    sofa's top (0.85 m) the cabinet hides nothing; a wall (no height recorded) still does."""
+    import numpy as np
+    from hiconav.trees.behaviours.viewing import approach_cell
+
+    from .fakes import open_grid
+
+    lo, hi = np.array([4.0, 2.0, 0.0]), np.array([5.0, 6.0, 0.85])  # the sofa, 4 m long
+    robot = np.array([4.6, 6.7])  # 0.7 m past its end
+    for top, stays in ((0.8, True), (0.0, False)):
+        grid = open_grid()
+        grid.state[61:64, 43:48] = 1  # 0.1-0.4 m past the sofa's end: a cabinet, or a wall
+        grid.top = np.zeros(grid.state.shape, dtype=np.float32)
+        grid.top[61:64, 43:48] = top
+        cell = approach_cell(grid, lo, hi, robot, 0.75, furniture=[], centre_weight=0.9, strict_walls=True,
+                             wall_heights=(0.88, 0.85))
+        moved = cell is None or float(np.hypot(*(cell - robot))) > 0.3
+        assert moved != stays, (top, cell)
+        walls = approach_cell(grid, lo, hi, robot, 0.75, furniture=[], centre_weight=0.9, strict_walls=True)
+        assert walls is None or float(np.hypot(*(walls - robot))) > 0.3  # without heights: a wall
+
+
 def test_approach_cell_on_a_settle_ring_is_the_one_nearest_the_object():
     """Gibson: with no free cell within 0.8 m the robot settled on the 1 m ring at the cell nearest
     to itself, 0.96-1.06 m from the box, where the box's error decides success; with the box

@@ -403,6 +403,17 @@ class _GoToObject(MissionBehaviour):
         """approach_cell's ``sight`` argument, or None: cells need not see the candidate."""
         return None
 
+    def _camera(self) -> tuple[float, float] | None:
+        """(camera height m, vertical field of view rad) from the newest memory anchor, or None."""
+        anchors = tuple(getattr(self.context.memory, "anchors", ()) or ())
+        if not anchors:
+            return None
+        a = max(anchors, key=lambda a: int(a.id))
+        K = getattr(a, "intrinsics", None)
+        if K is None:
+            return None
+        return float(np.asarray(a.T_world_cam)[2, 3]), 2.0 * math.atan2(K.height / 2.0, K.fy)
+
     def _send(self, cand: Candidate, distance: float, strict_walls: bool = False, box_weight: float = 0.0) -> bool:
         ctx = self.context
         pose = ctx.pose
@@ -413,9 +424,11 @@ class _GoToObject(MissionBehaviour):
         memory = ctx.memory
         furniture = [(np.asarray(o.box_min), np.asarray(o.box_max)) for o in getattr(memory, "objects", ())
                      if int(o.id) != int(cand.object_id)]
+        camera = self._camera()
+        heights = None if camera is None else (camera[0], float(np.asarray(cand.box_max)[2]))
         kw = {"centre_weight": self._centre_weight(), "prefer_xy": prefer, "prefer_weight": self._prefer_weight(),
               "sight": self._sight(cand), "furniture": furniture, "strict_walls": strict_walls,
-              "box_weight": box_weight}
+              "box_weight": box_weight, "wall_heights": heights}
         cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, **kw)
         if cell is None:  # furniture around it: a cell only the robot radius clears will do
             cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, tight=True,
@@ -537,17 +550,6 @@ class VerifyTarget(_GoToObject):
     def _close_distance(self, cand: Candidate) -> float:
         """Within this distance of the footprint the robot judges the candidate's views."""
         return max(self.param("verify_distance"), self._goal_distance(cand) + 0.35) + 0.25
-
-    def _camera(self) -> tuple[float, float] | None:
-        """(camera height m, vertical field of view rad) from the newest memory anchor, or None."""
-        anchors = tuple(getattr(self.context.memory, "anchors", ()) or ())
-        if not anchors:
-            return None
-        a = max(anchors, key=lambda a: int(a.id))
-        K = getattr(a, "intrinsics", None)
-        if K is None:
-            return None
-        return float(np.asarray(a.T_world_cam)[2, 3]), 2.0 * math.atan2(K.height / 2.0, K.fy)
 
     def _blockers(self, cand: Candidate, support: set[int] | None = None) -> tuple[np.ndarray, np.ndarray] | None:
         """3D boxes (lo, hi) of the memory's other objects, shrunk by 5 cm a side horizontally:
