@@ -60,6 +60,12 @@ class NavigatorConfig(BaseModel):
         True, description="cells the robot centre has passed through are traversable (it stood there), "
         "even where the map's inflation closes them"
     )
+    settle_steps: int = Field(
+        10, ge=1, description="discrete: within settle_m of the goal (or of its snapped path end), this many steps "
+        "without coming 2 cm nearer count as reached (a robot stepping 0.25 m can circle a goal that lies "
+        "between two of its positions)"
+    )
+    settle_m: float = Field(0.3, ge=0.0, description="see settle_steps")
     replan_every: int = Field(10, ge=1, description="re-plan at least every n steps")
     deviation_m: float = Field(0.5, gt=0.0, description="re-plan when this far from the path")
     stuck_progress_m: float = Field(0.05, ge=0.0, description="a forward step moving less than this is stuck")

@@ -347,3 +347,27 @@ def test_a_straight_goal_steps_up_to_the_obstacle_without_a_plan():
     assert nav.step(grid, pose) == DiscreteAction.STOP
     far, nav = run(Goal(2.0, 2.5, 0.0, tolerance=0.1, straight=True))
     assert nav.reached and abs(far.x - 2.05) < 1e-9  # within half a step of the point: done
+
+
+def test_a_robot_circling_near_its_goal_settles_there_but_not_far_from_it():
+    """ProcTHOR val/45/2: 0.25 m steps carried the robot back and forth across a goal it stood
+    0.12-0.13 m from, never within its 0.125 m reach, for 460 steps. Within settle_m, settle_steps steps
+    without coming 2 cm nearer count as reached; farther out the same rocking does not."""
+    from hiconav.planning.config import NavigatorConfig
+
+    grid = snapshot(open_room())
+
+    def rock(nav: Navigator, goal: Goal, offset: float, steps: int) -> int | None:
+        nav.set_goal(goal)
+        for i in range(steps):  # whatever it asks for, the robot lands on one side or the other
+            side = 1.0 if i % 2 else -1.0
+            pose = Pose2D(goal.x + side * offset, goal.y + 0.03, 0.0)
+            if nav.step(grid, pose) == DiscreteAction.STOP and nav.reached:
+                return i
+        return None
+
+    goal = Goal(2.5, 2.5, tolerance=0.1)
+    assert rock(Navigator(), goal, 0.16, 60) is not None
+    assert rock(Navigator(), goal, 0.16, 60) <= NavigatorConfig().settle_steps + 2
+    assert rock(Navigator(), goal, 0.5, 60) is None  # 0.5 m off: not there
+    assert rock(Navigator(NavigatorConfig(settle_steps=1000)), goal, 0.16, 60) is None

@@ -1005,7 +1005,7 @@ def test_a_no_view_point_deferral_lapses_once_the_map_around_the_candidate_grows
     ctx = _ctx(clock)
     grid = _unknown_room()
     ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
-    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, max_deferrals: 2}")
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, max_deferrals: 2, closer_moves: 0}")
     assert tree.tick() == S.FAILURE
     assert ctx.rejections[-1] == (3, "no reachable view point") and ctx.excluded(3)
     clock.t = 1.0
@@ -1015,10 +1015,30 @@ def test_a_no_view_point_deferral_lapses_once_the_map_around_the_candidate_grows
     assert not ctx.excluded(3)
     assert any("map around it grew by 1.2 m^2" in e for e in ctx.events)
     # a second map deferral is not the max_deferrals-th: the candidate stays deferred, not rejected
-    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, max_deferrals: 2}")
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, max_deferrals: 2, closer_moves: 0}")
     ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
     assert tree.tick() == S.FAILURE
     assert 3 not in ctx.rejected and ctx.remaps[3] == 2
+
+
+def test_with_no_view_cell_on_the_map_verify_closes_in_on_the_candidate_before_deferring(tmp_path):
+    """Gibson Coffeen/0/1: a chair 4 m off had no view cell on the young map, and its deferral sent
+    the robot exploring elsewhere by the plan's order. VerifyTarget first drives to the known
+    free cell nearest the candidate (closer_moves times), which shows the floor around it; only
+    when no cell is closer by closer_min_gain does it defer."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    grid = _unknown_room()
+    ctx.world = world(Pose2D(1.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, closer_moves: 1}")
+    assert tree.tick() == S.RUNNING
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    assert goal.goal.kind == "approach" and 2.5 <= goal.goal.x <= 3.0 and goal.goal.y > 4.0  # by the edge of the known
+    assert not ctx.rejections and any("closing in" in e for e in ctx.events)
+    ctx.world = world(Pose2D(goal.goal.x, goal.goal.y, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
+    ctx.nav = NavStatus(goal.seq, "reached", 0.0)
+    assert tree.tick() == S.FAILURE  # still no view cell, and its one closer move is spent
+    assert ctx.rejections[-1] == (3, "no reachable view point")
 
 
 def test_map_deferrals_stop_lapsing_after_max_remaps_and_remap_area_zero_disables_them():
