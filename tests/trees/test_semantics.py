@@ -633,6 +633,29 @@ def test_approach_settled_beyond_its_distance_creeps_through_unknown_floor_then_
     assert tree.tick() == S.SUCCESS
 
 
+def test_approach_reached_short_of_its_ring_creeps_on_instead_of_driving_to_another_cell(tmp_path):
+    """The navigator's 0.2 m tolerance stops the robot short of its cell: Gibson Allensville/0/0
+    stood 1.02 m from a sofa's box at a cell of the 1 m ring, was not "within" it, and drove
+    1.4 m to a second cell. It steps straight toward the box instead, then faces it."""
+    ctx = _ctx(Clock())
+    ctx.world = world(Pose2D(1.5, 5.0, 0.0), [obj(3, "bed", 5.0, 5.0)])
+    tree = _confirmed_then(tmp_path, ctx, "Approach: {distance: 0.8, inner_margin: 0.05}")
+    assert tree.tick() == S.RUNNING
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert goal.kind == "approach" and 0.7 <= 4.5 - goal.x <= 0.8  # the bed's box spans 4.5-5.5
+    short = Pose2D(goal.x - 0.15, goal.y, 0.0)  # reached, within the tolerance, 0.85+ m off the box
+    assert 4.5 - short.x > 0.8
+    ctx.world = world(short, [obj(3, "bed", 5.0, 5.0)])
+    ctx.nav = NavStatus([m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].seq, "reached", 0.0)
+    assert tree.tick() == S.RUNNING
+    creep = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    assert creep.goal.straight and creep.goal.x == pytest.approx(4.5) and creep.goal.tolerance == pytest.approx(0.8)
+    ctx.world = world(Pose2D(short.x + 0.25, short.y, 0.0), [obj(3, "bed", 5.0, 5.0)])
+    ctx.nav = NavStatus(creep.seq, "reached", 0.0)
+    assert tree.tick() == S.RUNNING  # faces it
+    assert tree.tick() == S.SUCCESS
+
+
 def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(tmp_path):
     """A node's label is a vote: a real fridge read as 'cabinet' for a while came back as a
     fridge, but a permanent rejection had already made the robot explore the house out."""
