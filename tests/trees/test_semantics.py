@@ -1019,16 +1019,22 @@ def _unknown_room() -> "object":
     return grid
 
 
+def _verify_beyond_the_known(tmp_path: Path, x: float, params: str):
+    """VerifyTarget (``params``) on a bed at (6, 6) observed 5 times, from (x, 2) in the room known
+    only up to x = 3 m: (clock, context, grid, tree)."""
+    clock = Clock()
+    ctx = _ctx(clock)
+    grid = _unknown_room()
+    ctx.world = world(Pose2D(x, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
+    return clock, ctx, grid, _confirmed_then(tmp_path, ctx, f"VerifyTarget: {{{params}}}")
+
+
 def test_a_no_view_point_deferral_lapses_once_the_map_around_the_candidate_grows(tmp_path):
     """Gibson Leonardo/0/2: judged on the first frames' map, a plant 4 m off had no reachable view
     cell, and its 30 s deferral sent the robot 39 m about the house, past the plant. Once the
     known free floor within 2 m of the candidate has grown by remap_area_m2 it is due again (and
     the deferral does not count toward max_deferrals)."""
-    clock = Clock()
-    ctx = _ctx(clock)
-    grid = _unknown_room()
-    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
-    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, max_deferrals: 2, closer_moves: 0}")
+    clock, ctx, grid, tree = _verify_beyond_the_known(tmp_path, 2.0, "defer_s: 30, max_deferrals: 2, closer_moves: 0")
     assert tree.tick() == S.FAILURE
     assert ctx.rejections[-1] == (3, "no reachable view point") and ctx.excluded(3)
     clock.t = 1.0
@@ -1045,15 +1051,11 @@ def test_a_no_view_point_deferral_lapses_once_the_map_around_the_candidate_grows
 
 
 def test_with_no_view_cell_on_the_map_verify_closes_in_on_the_candidate_before_deferring(tmp_path):
-    """Gibson Coffeen/0/1: a chair 4 m off had no view cell on the young map, and its deferral sent
+    """Gibson Cosmos/0/2: a chair 5.2 m off had no view cell on the young map, and its deferral sent
     the robot exploring elsewhere by the plan's order. VerifyTarget first drives to the known
     free cell nearest the candidate (closer_moves times), which shows the floor around it; only
     when no cell is closer by closer_min_gain does it defer."""
-    clock = Clock()
-    ctx = _ctx(clock)
-    grid = _unknown_room()
-    ctx.world = world(Pose2D(1.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
-    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, closer_moves: 1}")
+    _, ctx, grid, tree = _verify_beyond_the_known(tmp_path, 1.0, "defer_s: 30, closer_moves: 1")
     assert tree.tick() == S.RUNNING
     goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
     assert goal.goal.kind == "approach" and 2.5 <= goal.goal.x <= 3.0 and goal.goal.y > 4.0  # by the edge of the known
