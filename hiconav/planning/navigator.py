@@ -315,10 +315,10 @@ class Navigator:
         """Within the goal's tolerance, at the end of a path snapped off a blocked goal or, with
         ``settle`` (discrete steps), settled near it (``_settled``)."""
         assert self.goal is not None
-        if pose.distance_to(Pose2D(self.goal.x, self.goal.y, 0.0)) <= self.goal.tolerance:
+        d = pose.distance_to(Pose2D(self.goal.x, self.goal.y, 0.0))
+        if d <= self.goal.tolerance:
             return True
         # the goal itself may be blocked: reaching the end of the snapped path counts
-        d = pose.distance_to(Pose2D(self.goal.x, self.goal.y, 0.0))
         if self.path_xy is not None and len(self.path_xy) >= 1:
             end = self.path_xy[-1]
             if np.hypot(*(end - self.goal.xy)) <= self.config.goal_snap_m:

@@ -440,11 +440,15 @@ class _GoToObject(MissionBehaviour):
                                  **kw)
         if cell is None:
             return False
+        self._go_to_cell(cand, cell, 0.2)
+        return True
+
+    def _go_to_cell(self, cand: Candidate, cell: np.ndarray, tolerance: float) -> None:
+        """Send the goal ``cell`` (world xy) facing the candidate, and restart the stall clock."""
         self._cell = cell
         self._progress: tuple[float, float] | None = None  # (best distance to the cell, clock time)
-        self._seq = ctx.send_goal(Goal(float(cell[0]), float(cell[1]), _facing(cell, cand.center), 0.2,
-                                       "approach", cand.object_id))
-        return True
+        self._seq = self.context.send_goal(Goal(float(cell[0]), float(cell[1]), _facing(cell, cand.center),
+                                                tolerance, "approach", cand.object_id))
 
     # a goal cell the robot has come no nearer to (by 0.25 m) for this many clock seconds counts
     # as failed: a navigator rocking in a doorway held ProcTHOR val/52/1 for 350 steps, while
@@ -644,10 +648,7 @@ class VerifyTarget(_GoToObject):
             return False
         self._closer_moves += 1
         self._closing = True
-        self._cell = cell
-        self._progress = None
-        self._seq = ctx.send_goal(Goal(float(cell[0]), float(cell[1]), _facing(cell, cand.center), 0.3,
-                                       "approach", cand.object_id))
+        self._go_to_cell(cand, cell, 0.3)
         ctx.log(f"no view cell of #{cand.object_id} on the map yet: closing in to "
                 f"({cell[0]:.2f}, {cell[1]:.2f}), {gap:.1f} m from it now")
         return True
