@@ -49,11 +49,13 @@ class FakeAnchor:
     T_world_cam: np.ndarray
     object_ids: tuple = ()
     intrinsics: CameraIntrinsics = CameraIntrinsics.from_hfov(640, 480, 79.0)
+    labels_seen: tuple = ()
 
 
-def anchor(aid: int, pose: Pose2D, object_ids: tuple = (), height: float = 0.4) -> FakeAnchor:
-    """An anchor whose camera stands at the pose, ``height`` m up, looking along its yaw."""
-    return FakeAnchor(aid, camera_pose_from_base(pose, height), tuple(object_ids))
+def anchor(aid: int, pose: Pose2D, object_ids: tuple = (), height: float = 0.4, labels_seen: tuple = ()) -> FakeAnchor:
+    """An anchor whose camera stands at the pose, ``height`` m up, looking along its yaw;
+    ``labels_seen``: labels detected in it, placed on a node or not."""
+    return FakeAnchor(aid, camera_pose_from_base(pose, height), tuple(object_ids), labels_seen=tuple(labels_seen))
 
 
 @dataclass(frozen=True)

@@ -195,6 +195,34 @@ def test_verify_confirms_with_fresh_views_when_close(tmp_path):
     assert tree.tick() == S.SUCCESS
 
 
+def test_verify_counts_a_detection_too_near_for_depth_as_a_fresh_view(tmp_path):
+    """0.4 m from the bed's box the depth camera reads nothing, so the bed's detection lands on no
+    node; the frame still detected a bed where the candidate is (Gibson Tolstoy/0/3 rejected a
+    real toilet so). From 0.7 m, or where the frame placed its bed on another node, it does not count."""
+    near = Pose2D(4.1, 5.0, 0.0)  # 0.4 m from the box's face, facing its centre
+
+    def frames(pose, params, other=False):
+        ctx, tree = _verify_tree(tmp_path, Clock(), params, pose)
+        objects = [obj(3, "bed", 5.0, 5.0)] + ([obj(7, "bed", 9.0, 5.0)] if other else [])
+        tree.tick()
+        statuses = []
+        for aid in range(2, 6):
+            a = anchor(aid, pose, (7,) if other else (), labels_seen=("bed",))
+            ctx.world = world(pose, objects, anchors=[a])
+            statuses.append(tree.tick())
+        return statuses, ctx
+
+    params = "min_fresh_views: 2, max_view_frames: 8, unseen_view_frames: 4, min_confidence: 0.0"
+    statuses, _ = frames(near, params)
+    assert statuses[:2] == [S.RUNNING, S.SUCCESS]
+    statuses, ctx = frames(FACING_BED, params)  # 0.7 m from the box: depth reaches it, a miss
+    assert statuses[-1] == S.FAILURE and "0 of 4 frames" in ctx.rejections[-1][1]
+    statuses, ctx = frames(near, params, other=True)  # the frame's bed is node 7, 4 m off
+    assert statuses[-1] == S.FAILURE and "0 of 4 frames" in ctx.rejections[-1][1]
+    statuses, ctx = frames(near, params + ", near_view_distance: 0.0")
+    assert statuses[-1] == S.FAILURE
+
+
 def test_verify_rejects_a_candidate_rarely_detected_while_in_view(tmp_path):
     """A spurious box that fell on a place once is outvoted by the frames that show nothing there."""
     ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 10")
