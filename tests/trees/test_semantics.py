@@ -195,6 +195,27 @@ def test_verify_confirms_with_fresh_views_when_close(tmp_path):
     assert tree.tick() == S.SUCCESS
 
 
+def test_verify_hands_on_the_node_its_fresh_views_observed(tmp_path):
+    """A table read as a sofa (#3), its box touching the real sofa's (#8): the fresh views saw #8,
+    so the target written for Approach is #8, not the table (Gibson Marstons/0/1 stopped on the
+    table's far side, 2.1 m from the sofa). Views of the candidate itself keep the candidate."""
+    def verify(observed: tuple) -> object:
+        ctx = _ctx(Clock())
+        objects = [obj(3, "bed", 5.0, 5.0, n_obs=3), obj(8, "bed", 6.0, 5.0)]
+        ctx.world = world(FACING_BED, objects, anchors=[anchor(1, FACING_BED, (3,))])
+        tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {min_fresh_views: 2}")
+        tree.tick()
+        for aid in (2, 3):
+            ctx.world = world(FACING_BED, objects, anchors=[anchor(aid, FACING_BED, observed)])
+            status = tree.tick()
+        assert status == S.SUCCESS
+        return _node(tree, "VerifyTarget").read("target")
+
+    assert verify((8,)).object_id == 8
+    assert verify((3, 8)).object_id == 3
+    assert verify((3,)).object_id == 3
+
+
 def test_verify_counts_a_detection_too_near_for_depth_as_a_fresh_view(tmp_path):
     """0.4 m from the bed's box the depth camera reads nothing, so the bed's detection lands on no
     node; the frame still detected a bed where the candidate is (Gibson Tolstoy/0/3 rejected a
