@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -73,6 +73,12 @@ class FakeMemory:
 
 def world(pose: Pose2D, objects=(), seq: int = 0, grid: FakeGrid | None = None, version: int = 0,
           anchors=()) -> WorldSnapshot:
+    """A snapshot; an anchor given no ``labels_seen`` detected the labels of the nodes it observed
+    (as the memory records them when each detection matched its node's label)."""
+    labels = {o.id: o.label for o in objects}
+    anchors = [a if a.labels_seen or not a.object_ids else
+               replace(a, labels_seen=tuple(dict.fromkeys(labels[i] for i in a.object_ids if i in labels)))
+               for a in anchors]
     return WorldSnapshot(seq, 0.0, pose, grid if grid is not None else open_grid(),
                          FakeMemory(tuple(objects), tuple(anchors), version=version))
 

@@ -216,6 +216,31 @@ def test_verify_hands_on_the_node_its_fresh_views_observed(tmp_path):
     assert verify((3,)).object_id == 3
 
 
+def test_verify_counts_only_frames_that_read_the_candidate_as_a_target(tmp_path):
+    """A node's label is a vote over its observations: a sofa read twice as "bed" stays a "bed"
+    node while frames that read it "sofa" observe it. Those frames show something there, but a
+    bed is confirmed only when more of them read "bed" than not (Gibson Woodbine/0/3 stopped at
+    a sofa confirmed as a bed so); read as something else as often as not, the candidate is
+    deferred until it is observed as the target again, not rejected."""
+    def frames(reads: list[tuple]) -> tuple[list, MissionContext]:
+        ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, max_view_frames: 4")
+        tree.tick()
+        statuses = []
+        for aid, labels_seen in enumerate(reads, start=2):
+            a = anchor(aid, FACING_BED, (3,), labels_seen=labels_seen)
+            ctx.world = world(FACING_BED, [obj(3, "bed", 5.0, 5.0)], anchors=[a])
+            statuses.append(tree.tick())
+        return statuses, ctx
+
+    statuses, ctx = frames([("sofa",)] * 4)
+    assert statuses == [S.RUNNING] * 3 + [S.FAILURE]
+    assert "0 of 4 fresh views" in ctx.rejections[-1][1] and 3 not in ctx.rejected and 3 in ctx.deferred_obs
+    statuses, _ = frames([("bed",), ("sofa",), ("bed",)])  # 1 to 1 after two views: look on
+    assert statuses == [S.RUNNING, S.RUNNING, S.SUCCESS]
+    statuses, _ = frames([("sofa", "bed")] * 2)  # a bed detected in the frame
+    assert statuses[-1] == S.SUCCESS
+
+
 def test_verify_counts_a_detection_too_near_for_depth_as_a_fresh_view(tmp_path):
     """0.4 m from the bed's box the depth camera reads nothing, so the bed's detection lands on no
     node; the frame still detected a bed where the candidate is (Gibson Tolstoy/0/3 rejected a
