@@ -486,7 +486,13 @@ class VerifyTarget(_GoToObject):
 
     Fresh views count only target-labelled nodes whose box overlaps the candidate's (grown by
     ``support_margin``): counting every same-label node within a radius let spurious boxes cast
-    while the robot stares at a false candidate confirm it.
+    while the robot stares at a false candidate confirm it. More of them must have read a target
+    label than not (a node's label is a vote over all its observations; seen but read otherwise
+    as often as not by ``max_view_frames``, the candidate is deferred until it is observed as the
+    target again). A frame within ``near_view_distance`` of the candidate that detected a target
+    label it could not place in 3D (nearer than the depth camera's minimum range) is a fresh view
+    too. The target handed on is the supporting node the fresh views observed most, when that
+    is not the candidate itself.
 
     Only anchors whose camera could show the candidate count (``anchor_sees``: its centre in
     the image, no other memory object's box on the line of sight). The view cell is chosen
@@ -729,8 +735,8 @@ class VerifyTarget(_GoToObject):
         detector saw another node there, that node is the object found. A table read once as a
         sofa, its box touching the real sofa's, was confirmed by views of the sofa, and the robot
         stopped at the table's far side, 2.1 m from the sofa (Gibson Marstons/0/1)."""
-        best = max(self._fresh_by.items(), key=lambda kv: (kv[1], kv[0] == int(cand.object_id)), default=None)
-        if best is None or best[0] == int(cand.object_id) or best[1] <= self._fresh_by.get(int(cand.object_id), 0):
+        best = max(self._fresh_by.items(), key=lambda kv: kv[1], default=None)
+        if best is None or best[1] <= self._fresh_by.get(int(cand.object_id), 0):
             return cand
         node = self.context.object(best[0])
         if node is None:
@@ -770,8 +776,7 @@ class VerifyTarget(_GoToObject):
     def _support_ids(self, cand: Candidate) -> set[int]:
         """Ids of the target-labelled nodes whose footprint overlaps the candidate's (grown by
         ``support_margin``)."""
-        labels = set(self.context.task.targets) if self.context.task is not None else {cand.label}
-        labels.add(cand.label)
+        labels = self._target_labels(cand)
         margin = self.param("support_margin")
         lo, hi = np.asarray(cand.box_min)[:2] - margin, np.asarray(cand.box_max)[:2] + margin
         return {int(o.id) for o in self.context.memory.objects if o.label in labels
@@ -838,17 +843,17 @@ class VerifyTarget(_GoToObject):
                 # deferred: the views were fresh; the oracle and real detectors score small objects
                 # low, and a laptop seen 14 times was rejected for good at 0.29 (val/26/2)
                 return self._reject(f"confidence {conf:.2f} below {self.param('min_confidence')}", False)
+            if seen and frames >= self.param("max_view_frames"):
+                # there, but read as something else as often as not: not for good (its label may
+                # settle as the target's: due again after more observations as one)
+                return self._reject(f"read as {cand.label!r} in {self._target_reads} of {fresh} fresh views", False,
+                                    requalify=True)
             # a sequential test: a real object is detected in most frames that show it (a miss
             # rate of 0.3 leaves it undetected in 4 frames 1% of the time), a spurious box almost
             # never twice; glancing on to 8 frames at a candidate seen in none cost Gibson's
             # large floors ~60 steps a rejection, 180 of Newfields/0/1's 500. Only for candidates
             # observed once or twice: a real plant seen 17 times went undetected in 4 frames from
             # 0.8 m, its box a sliver of its front face (Gibson Onaga/0/1)
-            if seen and frames >= self.param("max_view_frames"):
-                # there, but read as something else as often as not: not for good (its label may
-                # settle as the target's: due again after more observations as one)
-                return self._reject(f"read as {cand.label!r} in {self._target_reads} of {fresh} fresh views", False,
-                                    requalify=True)
             unseen = fresh == 0 and frames >= self.param("unseen_view_frames") and \
                 int(obj.n_obs) <= self.param("unseen_max_observations")
             if frames >= self.param("max_view_frames") or unseen:
