@@ -320,6 +320,23 @@ def test_verify_does_not_count_frames_with_a_wall_between_camera_and_candidate(t
         assert any("0 of 4 frames" in why for _, why in ctx.rejections) == rejected
 
 
+def test_verify_counts_a_frame_that_placed_the_candidate_whatever_the_walls_on_the_map(tmp_path):
+    """The wall test keeps frames that could not show the candidate from counting as misses; a
+    frame that placed a detection on the candidate's node showed it. Gibson Stockman/0/2 deferred
+    a toilet placed on its node in 15 frames as "no view cell shows it", a wall cell on the map
+    crossing the line to its centre."""
+    from .fakes import open_grid
+
+    walled = open_grid()
+    walled.state[38:46, 42] = 1  # a wall stub across the line from (4, 4) to the bed at (5, 5)
+    ctx, tree = _verify_tree(tmp_path, Clock(), "min_fresh_views: 2, reposition_after: 100")
+    tree.tick()
+    for aid in (2, 3):
+        ctx.world = world(FACING_BED, [obj(3, "bed", 5.0, 5.0)], grid=walled, anchors=[anchor(aid, FACING_BED, (3,))])
+        status = tree.tick()
+    assert status == S.SUCCESS
+
+
 def test_verify_counts_frames_over_low_clutter_but_not_through_walls(tmp_path):
     """Gibson Allensville/0/0: a sofa seen over an unlabelled 0.8 m table (occupied on the 2D map,
     explained by no memory object) was in view in none of 8 frames that observed it. With obstacle

@@ -710,9 +710,14 @@ class VerifyTarget(_GoToObject):
         labels = {int(o.id): o.label for o in memory.objects}
         targets = self._target_labels(cand)
         for a, clear in zip(fresh, walls_clear):
-            if clear and anchor_sees(a, cand.center, blockers):
+            observed = support.intersection(int(i) for i in a.object_ids)
+            # a frame that placed a detection on the candidate in 3D showed it, whatever the map's
+            # walls and the memory's boxes suggest (the tests above keep frames that could not show
+            # it from counting as misses): a toilet placed on its node in 15 frames was deferred as
+            # "no view cell shows it", a wall cell on the map crossing the line to its centre
+            # (Gibson Stockman/0/2)
+            if observed or (clear and anchor_sees(a, cand.center, blockers)):
                 self._in_view += 1
-                observed = support.intersection(int(i) for i in a.object_ids)
                 for i in observed:
                     self._fresh_by[i] = self._fresh_by.get(i, 0) + 1
                 too_near = not observed and self._detected_too_near(a, cand, labels)
