@@ -237,13 +237,13 @@ class MissionContext:
             if oid is None or oid in seen or self.excluded(oid):
                 continue
             seen.add(oid)
-            out.append(self._candidate(objects[oid], "hypothesis", float(getattr(hyp, "confidence", 0.0))))
+            out.append(self.candidate_of(objects[oid], "hypothesis", float(getattr(hyp, "confidence", 0.0))))
         if self.use_memory_labels:
             targets = set(self.task.targets)
             matches = [o for o in memory.objects if o.label in targets and not self.excluded(o.id)
                        and o.id not in seen]
             matches.sort(key=lambda o: (-o.confidence * o.n_obs, o.id))
-            out += [self._candidate(o, "memory-label", float(o.confidence)) for o in matches]
+            out += [self.candidate_of(o, "memory-label", float(o.confidence)) for o in matches]
         return out
 
     def _resolve(self, hyp: Any, memory: Any, objects: dict[int, Any]) -> int | None:
@@ -265,7 +265,8 @@ class MissionContext:
         return best
 
     @staticmethod
-    def _candidate(obj: Any, source: str, confidence: float) -> Candidate:
+    def candidate_of(obj: Any, source: str, confidence: float) -> Candidate:
+        """A ``Candidate`` for the memory object node ``obj``."""
         return Candidate(int(obj.id), str(obj.label), np.asarray(obj.center, dtype=np.float64),
                          np.asarray(obj.box_min, dtype=np.float64), np.asarray(obj.box_max, dtype=np.float64),
                          confidence, int(obj.n_obs), source)

@@ -720,10 +720,10 @@ class VerifyTarget(_GoToObject):
                 self._in_view += 1
                 for i in observed:
                     self._fresh_by[i] = self._fresh_by.get(i, 0) + 1
-                too_near = not observed and self._detected_too_near(a, cand, labels)
-                self._fresh += int(bool(observed) or too_near)
-                self._target_reads += int(too_near or (bool(observed) and
-                                                       bool(targets.intersection(getattr(a, "labels_seen", ())))))
+                read = bool(targets.intersection(getattr(a, "labels_seen", ())))
+                fresh_view = bool(observed) or (read and self._detected_too_near(a, cand, labels, targets))
+                self._fresh += int(fresh_view)
+                self._target_reads += int(fresh_view and read)
             else:
                 self._unseen += 1
 
@@ -747,13 +747,12 @@ class VerifyTarget(_GoToObject):
         if node is None:
             return cand
         self.context.log(f"#{cand.object_id} confirmed by views of #{best[0]} ({best[1]} of them): going to #{best[0]}")
-        return Candidate(int(node.id), str(node.label), np.asarray(node.center, dtype=np.float64),
-                         np.asarray(node.box_min), np.asarray(node.box_max), float(node.confidence),
-                         int(node.n_obs), cand.source)
+        return self.context.candidate_of(node, cand.source, float(node.confidence))
 
-    def _detected_too_near(self, anchor: object, cand: Candidate, labels: dict[int, str]) -> bool:
-        """True when ``anchor``'s camera stood within ``near_view_distance`` of the candidate's box
-        and detected a target label that it placed on no node (``labels``: node id -> label).
+    def _detected_too_near(self, anchor: object, cand: Candidate, labels: dict[int, str], targets: set[str]) -> bool:
+        """True when ``anchor`` (which detected one of ``targets``, the target labels) placed no
+        target label on a node (``labels``: node id -> label) and its camera stood within
+        ``near_view_distance`` of the candidate's box.
 
         The depth camera reads nothing nearer than its minimum range (0.5 m in the simulator,
         as Habitat's), so a detection of an object that close has no 3D points and lands on no
@@ -761,17 +760,10 @@ class VerifyTarget(_GoToObject):
         frames, 0.43 m from the camera (Gibson Tolstoy/0/3). Within that range nothing else
         can be what the detector saw: a detection placed elsewhere explains its label instead."""
         near = self.param("near_view_distance")
-        if near <= 0.0:
-            return False
-        targets = self._target_labels(cand)
-        if not targets.intersection(getattr(anchor, "labels_seen", ())):
-            return False
-        if any(labels.get(int(i)) in targets for i in anchor.object_ids):
+        if near <= 0.0 or any(labels.get(int(i)) in targets for i in anchor.object_ids):
             return False
         cam = np.asarray(anchor.T_world_cam, dtype=np.float64)[:2, 3]
-        lo, hi = np.asarray(cand.box_min)[:2], np.asarray(cand.box_max)[:2]
-        gap = np.maximum(np.maximum(lo - cam, cam - hi), 0.0)
-        return float(np.hypot(*gap)) <= near
+        return self.context.distance_to_box(cand.box_min, cand.box_max, cam) <= near
 
     def _support_observations(self, cand: Candidate) -> int:
         """Observations of the target-labelled nodes at the candidate's place, summed."""
