@@ -122,6 +122,7 @@ class Navigator:
         self._trail_cache: tuple[tuple, tuple[np.ndarray, np.ndarray]] | None = None
         self._stuck = 0
         self._settle: tuple[float, int] | None = None  # (least distance to the goal or path end, steps since)
+        self._straight_from: float | None = None
         self._recovery: list[DiscreteAction] = []
         self._vel_recovery: list[tuple[float, float, float]] = []  # (v, omega, seconds)
         self._progress_ref: tuple[float, float, float] | None = None  # (x, y, elapsed)
@@ -150,6 +151,7 @@ class Navigator:
         self._stuck = 0
         self._progress_ref = None
         self._settle: tuple[float, int] | None = None
+        self._straight_from: float | None = None  # a straight goal's distance before its last step
         self.local.reset()
 
     def clear_virtual_obstacles(self) -> None:
@@ -420,8 +422,8 @@ class Navigator:
     def _step_straight(self, grid: GridLike, pose: Pose2D) -> DiscreteAction:
         """A ``Goal.straight`` step: face the goal and step forward, no plan; done (facing the
         goal's yaw) within its tolerance, within half a step of it, when a forward step was blocked
-        (moved less than ``stuck_progress_m``) or the point half a step ahead is a cell the map
-        knows occupied.
+        (moved the robot, or brought it nearer the goal, by less than ``stuck_progress_m``) or the
+        point half a step ahead is a cell the map knows occupied.
 
         The planner keeps the robot centre a robot radius from every occupied cell, and the cells'
         5 cm and their padding cost a few centimetres more; a creep toward an object ended 1.005 m
@@ -430,8 +432,15 @@ class Navigator:
         goal = self.goal
         assert goal is not None
         step = cfg.discrete.forward_step_m
-        blocked = self._forward_blocked(pose)
         d = float(np.hypot(*(goal.xy - pose.xy)))
+        # blocked: a forward step that moved the robot little, or that brought it no nearer the
+        # goal: sliding along the object's side it moved 0.05-0.08 m per step, first one way then
+        # the other as its heading to the goal swung, for 3 s (Gibson Ranchester/0/3: 1.2 m driven
+        # 0.95 m from a plant without coming nearer)
+        blocked = self._forward_blocked(pose) or (
+            self._last_action == DiscreteAction.MOVE_FORWARD and self._straight_from is not None
+            and self._straight_from - d < cfg.stuck_progress_m)
+        self._straight_from = None
         heading = math.atan2(goal.y - pose.y, goal.x - pose.x)
         done = self.reached or blocked or d <= max(goal.tolerance, 0.5 * step)
         if not done and abs(wrap_angle(heading - pose.yaw)) <= math.radians(cfg.discrete.turn_tolerance_deg):
@@ -449,6 +458,8 @@ class Navigator:
             return self._act(DiscreteAction.STOP, pose)
         self.status = "following"
         turn = heading_action(pose, heading, cfg.discrete.turn_tolerance_deg)
+        if turn is None:
+            self._straight_from = d  # this goal's distance before the step
         return self._act(turn if turn is not None else DiscreteAction.MOVE_FORWARD, pose)
 
     def _discrete_action(self, grid: GridLike, pose: Pose2D, target: np.ndarray) -> DiscreteAction:

@@ -349,6 +349,26 @@ def test_a_straight_goal_steps_up_to_the_obstacle_without_a_plan():
     assert nav.reached and abs(far.x - 2.05) < 1e-9  # within half a step of the point: done
 
 
+def test_a_straight_goal_ends_when_a_step_slides_along_the_obstacle_without_coming_nearer():
+    """Gibson Ranchester/0/3: creeping toward a plant's box corner, each forward step slid the
+    robot 0.05-0.08 m along the plant's side, one way then the other as its heading to the point
+    swung, for 3 s and 1.2 m of path without coming nearer. A step that moved the robot but
+    brought it no nearer the point is blocked too."""
+    grid = snapshot(open_room())
+    nav = Navigator()
+    goal = Goal(2.5, 3.5, None, tolerance=0.1, straight=True)
+    nav.set_goal(goal)
+    pose = Pose2D(2.5, 2.5, math.pi / 2)  # facing the point, 1 m off
+    assert nav.step(grid, pose) == DiscreteAction.MOVE_FORWARD
+    slid = Pose2D(2.57, 2.51, math.pi / 2)  # the step slid 0.07 m sideways, 0.01 m nearer
+    assert nav.step(grid, slid) == DiscreteAction.STOP and nav.reached
+    # a step that does bring it nearer goes on
+    nav = Navigator()
+    nav.set_goal(goal)
+    assert nav.step(grid, pose) == DiscreteAction.MOVE_FORWARD
+    assert nav.step(grid, Pose2D(2.5, 2.75, math.pi / 2)) == DiscreteAction.MOVE_FORWARD
+
+
 def test_a_robot_circling_near_its_goal_settles_there_but_not_far_from_it():
     """ProcTHOR val/45/2: 0.25 m steps carried the robot back and forth across a goal it stood
     0.12-0.13 m from, never within its 0.125 m reach, for 460 steps. Within settle_m, settle_steps steps
