@@ -225,7 +225,8 @@ class MissionContext:
 
     # -- candidates ------------------------------------------------------------------------------
     def candidates(self) -> list[Candidate]:
-        """Target candidates, best first: hypotheses (newest first) then label matches (fallback)."""
+        """Target candidates, best first: hypotheses (newest first) then label matches (fallback),
+        the nearest to the robot first (by evidence, confidence x observations, before a pose)."""
         memory = self.memory
         if memory is None or self.task is None:
             return []
@@ -242,7 +243,15 @@ class MissionContext:
             targets = set(self.task.targets)
             matches = [o for o in memory.objects if o.label in targets and not self.excluded(o.id)
                        and o.id not in seen]
-            matches.sort(key=lambda o: (-o.confidence * o.n_obs, o.id))
+            if self.pose is not None:
+                # nearest first: verification decides whether a label match is the target, and the
+                # way to a far one and back is what a wrong order costs. Ranked by evidence
+                # (confidence x observations), a plant seen five times 4 m off went before one
+                # seen once 2.2 m off, both real (Gibson Klickitat/0/3: 5.75 m driven, not 3.0);
+                # evidence first, then distance, gained less on Gibson (53.7 against 53.8 SPL)
+                matches.sort(key=lambda o: (self.distance_to_box(np.asarray(o.box_min), np.asarray(o.box_max)), o.id))
+            else:
+                matches.sort(key=lambda o: (-o.confidence * o.n_obs, o.id))
             out += [self.candidate_of(o, "memory-label", float(o.confidence)) for o in matches]
         return out
 

@@ -747,6 +747,18 @@ def test_approach_reached_short_of_its_ring_creeps_on_instead_of_driving_to_anot
     assert tree.tick() == S.SUCCESS
 
 
+def test_label_matches_are_candidates_nearest_first():
+    """Gibson Klickitat/0/3: ranked by confidence x observations, a plant seen five times 4 m off
+    was verified before a real plant seen once 2.2 m off (5.75 m driven instead of 3.0).
+    Verification judges each; the order only decides how far the robot drives to the first."""
+    ctx = _ctx(Clock())
+    far, near, other = obj(3, "bed", 8.0, 2.0, n_obs=9), obj(5, "bed", 4.5, 2.0, n_obs=1), obj(7, "sofa", 3.0, 2.0)
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [far, near, other])
+    assert [c.object_id for c in ctx.candidates()] == [5, 3]
+    ctx.world = world(Pose2D(9.0, 2.0, 0.0), [far, near, other])
+    assert [c.object_id for c in ctx.candidates()] == [3, 5]
+
+
 def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(tmp_path):
     """A node's label is a vote: a real fridge read as 'cabinet' for a while came back as a
     fridge, but a permanent rejection had already made the robot explore the house out."""
