@@ -759,6 +759,35 @@ def test_label_matches_are_candidates_nearest_first():
     assert [c.object_id for c in ctx.candidates()] == [3, 5]
 
 
+def test_verify_switches_on_the_way_to_a_candidate_that_shows_much_nearer(tmp_path):
+    """Gibson Onaga/0/2: on its way to a plant 4.5 m off the robot saw another 3.0 m off and
+    drove on (7.1 m; switching, 5.6 m). A candidate ``switch_margin`` nearer is verified
+    first, the other neither rejected nor deferred; not once frames are being judged, and not
+    for a smaller gain."""
+    def run(new_x: float, pose: Pose2D = Pose2D(1.0, 5.0, 0.0), margin: float = 1.0):
+        ctx = _ctx(Clock())
+        ctx.world = world(pose, [obj(3, "bed", 8.0, 5.0)])
+        tree = _confirmed_then(tmp_path, ctx, f"VerifyTarget: {{switch_margin: {margin}}}")
+        assert tree.tick() == S.RUNNING
+        ctx.world = world(pose, [obj(3, "bed", 8.0, 5.0), obj(5, "bed", new_x, 5.0)])
+        assert tree.tick() == S.RUNNING
+        return ctx, _node(tree, "VerifyTarget")
+
+    ctx, verify = run(5.0)  # 3.5 m off against 6.5 m
+    assert verify._cand.object_id == 5 and verify.read("target").object_id == 5
+    assert not ctx.rejections and [c.object_id for c in ctx.candidates()] == [5, 3]
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert goal.x < 4.5  # a view cell of the nearer bed
+    _, verify = run(6.0)  # 4.5 m off against 6.5 m: switches
+    assert verify._cand.object_id == 5
+    _, verify = run(7.3)  # 0.7 m nearer: stays
+    assert verify._cand.object_id == 3
+    _, verify = run(5.0, margin=0.0)  # never
+    assert verify._cand.object_id == 3
+    _, verify = run(7.0, pose=Pose2D(6.0, 5.0, 0.0))  # close to the first already: frames count, stays
+    assert verify._cand.object_id == 3
+
+
 def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(tmp_path):
     """A node's label is a vote: a real fridge read as 'cabinet' for a while came back as a
     fridge, but a permanent rejection had already made the robot explore the house out."""
