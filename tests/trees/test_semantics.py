@@ -788,6 +788,23 @@ def test_verify_switches_on_the_way_to_a_candidate_that_shows_much_nearer(tmp_pa
     assert verify._cand.object_id == 3
 
 
+def test_verify_switches_between_two_candidates_a_few_times_at_most(tmp_path):
+    """Two candidates whose ways pass nearer each other in turn must not trade places for ever:
+    after ``MAX_SWITCHES`` the behaviour keeps the one it has."""
+    ctx = _ctx(Clock())
+    beds = [obj(3, "bed", 8.0, 5.0), obj(5, "bed", 1.0, 5.0)]
+    ctx.world = world(Pose2D(3.0, 5.0, 0.0), beds[:1])
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {switch_margin: 1.0}")
+    tree.tick()
+    verify = _node(tree, "VerifyTarget")
+    ids = []
+    for x in (2.0, 7.0, 2.0, 7.0, 2.0, 7.0):  # the robot nears one bed, then the other
+        ctx.world = world(Pose2D(x, 2.0, 0.0), beds)
+        tree.tick()
+        ids.append(verify._cand.object_id)
+    assert ids[:3] == [5, 3, 5] and set(ids[3:]) == {5}
+
+
 def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(tmp_path):
     """A node's label is a vote: a real fridge read as 'cabinet' for a while came back as a
     fridge, but a permanent rejection had already made the robot explore the house out."""

@@ -546,6 +546,8 @@ class VerifyTarget(_GoToObject):
     # degrees from facing the target: 70 degrees apart, so that each glance passes the memory's
     # anchor gate (delta_theta = 45 deg) and adds a view, while the target stays in the field of view
     _GLANCES = (35.0, -35.0)
+    # switches to a nearer candidate per activation (see _nearer_candidate)
+    MAX_SWITCHES = 3
 
     def initialise(self) -> None:
         self._start = self.context.now()
@@ -562,6 +564,7 @@ class VerifyTarget(_GoToObject):
         self._glance = 0
         self._closing = False  # the goal in flight is a closer cell (``_send_closer``), not a view cell
         self._closer_moves = 0
+        self._switches = 0  # switches to a nearer candidate since the tree started this behaviour
         if self._cand is not None and self.context.verify:
             self._send(self._cand, self._goal_distance(self._cand))
 
@@ -575,7 +578,10 @@ class VerifyTarget(_GoToObject):
         the cheaper to judge; the other stays a candidate for later."""
         margin = self.param("switch_margin")
         ctx = self.context
-        if margin <= 0.0 or self._close or self._in_view or self._cand is None:
+        # a few switches at most: two candidates the way to each of which passes nearer the other
+        # must not trade places for ever
+        if margin <= 0.0 or self._close or self._in_view or self._cand is None or \
+                self._switches >= self.MAX_SWITCHES:
             return None
         here = ctx.distance_to_box(np.asarray(obj.box_min), np.asarray(obj.box_max))
         others = [c for c in ctx.candidates() if c.object_id != self._cand.object_id]
@@ -834,8 +840,10 @@ class VerifyTarget(_GoToObject):
         if nearer is not None:
             ctx.log(f"#{nearer.object_id} is {self.param('switch_margin'):.1f} m or more nearer than #{cand.object_id}: "
                     f"verifying it first")
+            switches = self._switches + 1
             self.write("target", nearer)
             self.initialise()  # the other candidate stays a candidate: it is neither rejected nor deferred
+            self._switches = switches
             self.feedback_message = f"verifying {nearer.label} #{nearer.object_id} first"
             return Status.RUNNING
         if ctx.task is not None and obj.label not in ctx.task.targets and cand.source == "memory-label":
