@@ -550,10 +550,15 @@ class VerifyTarget(_GoToObject):
     MAX_SWITCHES = 3
 
     def initialise(self) -> None:
+        self._switches = 0  # switches to a nearer candidate since the tree started this behaviour
+        self._take(self.read("target"))
+
+    def _take(self, cand: Candidate | None) -> None:
+        """Start judging ``cand``: every count and goal starts afresh."""
         self._start = self.context.now()
         self._seq = None
         self._excluded: list[np.ndarray] = []
-        self._cand: Candidate | None = self.read("target")
+        self._cand: Candidate | None = cand
         self._close = False  # the robot is within _close_distance of the candidate (this tick)
         self._last_anchor: int | None = None  # the newest memory anchor already judged
         self._fresh = 0  # anchors in view that observed the candidate
@@ -564,7 +569,6 @@ class VerifyTarget(_GoToObject):
         self._glance = 0
         self._closing = False  # the goal in flight is a closer cell (``_send_closer``), not a view cell
         self._closer_moves = 0
-        self._switches = 0  # switches to a nearer candidate since the tree started this behaviour
         if self._cand is not None and self.context.verify:
             self._send(self._cand, self._goal_distance(self._cand))
 
@@ -585,10 +589,9 @@ class VerifyTarget(_GoToObject):
             return None
         here = ctx.distance_to_box(np.asarray(obj.box_min), np.asarray(obj.box_max))
         others = [c for c in ctx.candidates() if c.object_id != self._cand.object_id]
-        best = min(others, key=lambda c: ctx.distance_to_box(c.box_min, c.box_max), default=None)
-        if best is None or ctx.distance_to_box(best.box_min, best.box_max) > here - margin:
-            return None
-        return best
+        gap, best = min(((ctx.distance_to_box(c.box_min, c.box_max), c) for c in others),
+                        key=lambda dc: dc[0], default=(math.inf, None))
+        return best if gap <= here - margin else None
 
     def _goal_distance(self, cand: Candidate) -> float:
         """The ring (m from the footprint) to view the candidate from: ``verify_distance`` less
@@ -840,10 +843,9 @@ class VerifyTarget(_GoToObject):
         if nearer is not None:
             ctx.log(f"#{nearer.object_id} is {self.param('switch_margin'):.1f} m or more nearer than #{cand.object_id}: "
                     f"verifying it first")
-            switches = self._switches + 1
             self.write("target", nearer)
-            self.initialise()  # the other candidate stays a candidate: it is neither rejected nor deferred
-            self._switches = switches
+            self._switches += 1
+            self._take(nearer)  # the other candidate stays a candidate: it is neither rejected nor deferred
             self.feedback_message = f"verifying {nearer.label} #{nearer.object_id} first"
             return Status.RUNNING
         if ctx.task is not None and obj.label not in ctx.task.targets and cand.source == "memory-label":
