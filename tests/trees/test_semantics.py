@@ -747,6 +747,69 @@ def test_approach_reached_short_of_its_ring_creeps_on_instead_of_driving_to_anot
     assert tree.tick() == S.SUCCESS
 
 
+def test_approach_a_step_beyond_its_ring_steps_straight_in_when_the_way_is_clear(tmp_path):
+    """Verification leaves the robot ~1.15 m from the box facing it; the ring cell in front of
+    the box's middle lay off the line in and cost a turn and a second step (Gibson: 31 of 89
+    successes began the approach inside the success region and drove on). With the way clear it
+    steps straight at the box's nearest point, done within the distance, then faces it."""
+    ctx = _ctx(Clock())
+    ctx.world = world(Pose2D(3.5, 4.7, 0.0), [obj(3, "bed", 5.0, 5.0)])  # 1.0 m off the box (4.5-5.5)
+    tree = _confirmed_then(tmp_path, ctx, "Approach: {distance: 0.85, inner_margin: 0.0}")
+    assert tree.tick() == S.RUNNING
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    assert goal.goal.straight and goal.goal.through_unknown
+    assert (goal.goal.x, goal.goal.y) == pytest.approx((4.5, 4.7)) and goal.goal.tolerance == pytest.approx(0.85)
+    assert "stepping in" in _node(tree, "Approach").feedback_message
+    ctx.world = world(Pose2D(3.75, 4.7, 0.0), [obj(3, "bed", 5.0, 5.0)])
+    ctx.nav = NavStatus(goal.seq, "reached", 0.0)
+    assert tree.tick() == S.RUNNING  # faces it
+    assert tree.tick() == S.SUCCESS
+
+
+def test_approach_goes_to_a_ring_cell_when_the_straight_way_in_is_blocked_or_too_long(tmp_path):
+    """A wall the map knows on the line in (or an object farther than a step or two beyond the
+    ring, or straight_within 0) keeps the ring cells; a straight way in that ends short of the
+    ring falls back to them too."""
+    from .fakes import open_grid
+
+    def first_goal(pose: Pose2D, grid=None, params: str = "distance: 0.85, inner_margin: 0.0"):
+        ctx = _ctx(Clock())
+        ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0)], grid=grid)
+        tree = _confirmed_then(tmp_path, ctx, f"Approach: {{{params}}}")
+        assert tree.tick() == S.RUNNING
+        return ctx, tree, [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+
+    walled = open_grid()
+    walled.state[44:50, 39] = 1  # a wall stub at x = 3.9-4.0 across the line y = 4.7
+    walled.inflated = walled.state == 1
+    assert not first_goal(Pose2D(3.5, 4.7, 0.0), walled)[2].goal.straight
+    assert not first_goal(Pose2D(2.5, 4.7, 0.0))[2].goal.straight  # 2.0 m off: drive to a cell
+    assert not first_goal(Pose2D(3.5, 4.7, 0.0), params="distance: 0.85, straight_within: 0.0")[2].goal.straight
+    ctx, tree, goal = first_goal(Pose2D(3.5, 4.7, 0.0))
+    assert goal.goal.straight
+    ctx.nav = NavStatus(goal.seq, "failed", 0.0)  # blocked by what the map does not know, 1.0 m off
+    assert tree.tick() == S.RUNNING
+    after = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    assert after is not None and after.kind == "approach" and not after.straight
+
+
+def test_approach_counts_rocking_near_its_cell_as_a_stall(tmp_path):
+    """Gibson Woodbine/0/1 (0.9 m ring): the robot rocked 0.2-0.45 m from an approach cell it never
+    reached for 480 steps; VerifyTarget's 0.35 m "there, glancing" allowance kept the stall clock
+    from running. Approach's cells are goals: after STALL_S without coming 0.25 m nearer it
+    tries another cell."""
+    ctx, tree, goal = _approach_bed(tmp_path, Pose2D(1.5, 1.5, 0.0))
+    clock = ctx.clock
+    near = [Pose2D(goal.x - 0.3, goal.y, 0.0), Pose2D(goal.x - 0.25, goal.y - 0.05, 0.0)]
+    cells = set()
+    for k in range(12):
+        clock.t = float(k)
+        ctx.world = world(near[k % 2], [obj(3, "bed", 5.0, 5.0)])
+        assert tree.tick() == S.RUNNING
+        cells.add(tuple(np.round(_node(tree, "Approach")._cell, 3)))
+    assert len(cells) >= 2  # gave the first cell up and went for another
+
+
 def test_label_matches_are_candidates_nearest_first():
     """Gibson Klickitat/0/3: ranked by confidence x observations, a plant seen five times 4 m off
     was verified before a real plant seen once 2.2 m off (5.75 m driven instead of 3.0).
