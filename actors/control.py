@@ -86,7 +86,7 @@ class ControlNode(Node):
             cmd = self.navigator.step_velocity(snap.grid, snap.pose, self.velocity_dt, now)
             if self.navigator.reached:
                 self._set_state("reached", now)
-            elif getattr(self.navigator, "status", "") == "no_path":
+            elif getattr(self.navigator, "status", "") in ("no_path", "stuck"):
                 self._set_state("failed", now)
             else:
                 self._command(now, velocity=cmd)

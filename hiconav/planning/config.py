@@ -74,6 +74,11 @@ class NavigatorConfig(BaseModel):
         0.15, ge=0.0, description="radius of the obstacle placed where the robot got stuck"
     )
     recovery_turns: int = Field(3, ge=1, description="discrete turns of a recovery (3 x 30 deg)")
+    max_recoveries: int = Field(
+        3, ge=0, description="recoveries for one goal within give_up_m of each other before the goal fails "
+                             "(status 'stuck'; 0: never give up)"
+    )
+    give_up_m: float = Field(0.5, ge=0.0, description="see max_recoveries")
     back_off_s: float = Field(1.0, ge=0.0, description="velocity mode: back off this long when stuck")
     back_off_speed: float = Field(0.15, ge=0.0)
     stuck_time_s: float = Field(2.0, gt=0.0, description="velocity mode: no progress this long is stuck")

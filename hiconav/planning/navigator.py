@@ -99,7 +99,8 @@ class Navigator:
     """Follows A* paths to a Goal on an occupancy grid (OccupancyGrid or GridSnapshot).
 
     Attributes: goal (Goal | None), reached (bool), status ("idle", "following", "reached",
-    "no_path", "recovering"), path_xy ((N, 2) world waypoints of the smoothed path or None),
+    "no_path", "recovering", "stuck": ``max_recoveries`` recoveries for the goal in one spot),
+    path_xy ((N, 2) world waypoints of the smoothed path or None),
     n_plans, n_recoveries.
     """
 
@@ -126,6 +127,7 @@ class Navigator:
         self._recovery: list[DiscreteAction] = []
         self._vel_recovery: list[tuple[float, float, float]] = []  # (v, omega, seconds)
         self._progress_ref: tuple[float, float, float] | None = None  # (x, y, elapsed)
+        self._recoveries_at: list[tuple[float, float]] = []  # where each recovery for this goal began
         self._elapsed = 0.0
         self.n_plans = 0
         self.n_recoveries = 0
@@ -150,6 +152,7 @@ class Navigator:
         self._vel_recovery.clear()
         self._stuck = 0
         self._progress_ref = None
+        self._recoveries_at = []
         self._settle: tuple[float, int] | None = None
         self._straight_from: float | None = None  # a straight goal's distance before its last step
         self.local.reset()
@@ -356,6 +359,27 @@ class Navigator:
         d = ray_cast_grid(blocked, (float(rc[0]), float(rc[1])), angles, 2.0 / grid.resolution)
         return 1 if d[:2].sum() >= d[2:].sum() else -1
 
+    def _give_up(self, pose: Pose2D) -> bool:
+        """Record a recovery about to start at ``pose``; True (status "stuck") when ``max_recoveries``
+        recoveries for this goal, this one included, began within ``give_up_m`` of it.
+
+        A recovery turns away and steps; the robot that comes back to the same blocked step
+        recovers again, and only the mission's stall clock ended it: Gibson Lindenwood/0/0 turned
+        between two headings in one spot for 16 s of clock (two frontiers of 8 s each). Failing
+        the goal hands the choice back to the mission, which tries the next frontier or cell."""
+        cfg = self.config
+        self._recoveries_at.append((pose.x, pose.y))
+        if cfg.max_recoveries <= 0:
+            return False
+        near = sum(1 for x, y in self._recoveries_at if math.hypot(pose.x - x, pose.y - y) <= cfg.give_up_m)
+        if near < cfg.max_recoveries:
+            return False
+        self.status = "stuck"
+        self._recovery.clear()
+        self._vel_recovery.clear()
+        log.info("navigator: %d recoveries at (%.2f, %.2f) for this goal: giving it up", near, pose.x, pose.y)
+        return True
+
     def _add_virtual_obstacle(self, pose: Pose2D) -> None:
         r = self.config.virtual_obstacle_m
         if r <= 0:
@@ -381,6 +405,8 @@ class Navigator:
                 self._add_virtual_obstacle(pose)
                 self.path_xy = None  # force a re-plan around the new obstacle
                 if self._stuck >= cfg.stuck_limit and not self._recovery:
+                    if self._give_up(pose):
+                        return self._act(DiscreteAction.STOP, pose)
                     side = self._open_side(grid, pose)
                     turn = DiscreteAction.TURN_LEFT if side > 0 else DiscreteAction.TURN_RIGHT
                     self._recovery = [turn] * cfg.recovery_turns + [DiscreteAction.MOVE_FORWARD]
@@ -542,6 +568,9 @@ class Navigator:
         elif self._elapsed - self._progress_ref[2] >= cfg.stuck_time_s:
             moved = math.hypot(pose.x - self._progress_ref[0], pose.y - self._progress_ref[1])
             if moved < cfg.stuck_progress_m * 2:
+                if self._give_up(pose):
+                    self.local.reset()
+                    return VelocityCommand.zero(stamp)
                 self._add_virtual_obstacle(pose)
                 side = self._open_side(grid, pose)
                 self._vel_recovery = [

@@ -11,6 +11,7 @@ import pytest
 from hiconav.mapping import GridSnapshot
 from hiconav.mapping.occupancy import disk_kernel
 from hiconav.planning import Navigator, PurePursuit, heading_action, lookahead_point, to_discrete
+from hiconav.planning.config import NavigatorConfig
 from hiconav.planning.local_planner import segment_target
 from hiconav.planning.navigator import squeeze_mask
 from hiconav.types import DiscreteAction, Goal, Pose2D, VelocityCommand
@@ -175,6 +176,46 @@ def test_velocity_mode_backs_off_when_stuck():
     assert any(c.v < 0 for c in cmds), "no back-off"
     assert nav.n_recoveries >= 1
     assert all(isinstance(c, VelocityCommand) for c in cmds)
+
+
+def test_a_goal_fails_after_max_recoveries_in_one_spot():
+    """Gibson Lindenwood/0/0: blocked by what the map did not know, the robot recovered (turned
+    away and stepped) and came back to the same blocked step for 16 s of clock, until the
+    mission's stall clock gave up. The navigator gives the goal up itself ("stuck", a STOP the
+    control actor reports as failed) after max_recoveries recoveries within give_up_m; with 0 it
+    never does."""
+    grid = snapshot(open_room())
+    for limit, gives_up in ((3, True), (0, False)):
+        nav = Navigator(NavigatorConfig(max_recoveries=limit))
+        nav.set_goal(Goal(4.0, 2.5, tolerance=0.25))
+        pose = Pose2D(1.0, 2.5, 0.0)
+        actions = []
+        for _ in range(120):  # the robot never moves: every forward step is blocked
+            a = nav.step(grid, pose)
+            actions.append(a)
+            if a == DiscreteAction.STOP:
+                break
+            if a in (DiscreteAction.TURN_LEFT, DiscreteAction.TURN_RIGHT):
+                turn = math.radians(30.0) * (1 if a == DiscreteAction.TURN_LEFT else -1)
+                pose = Pose2D(pose.x, pose.y, pose.yaw + turn)
+        assert (nav.status == "stuck") == gives_up, nav.status
+        assert (actions[-1] == DiscreteAction.STOP) == gives_up
+        assert nav.n_recoveries == limit - 1 if gives_up else nav.n_recoveries >= 3
+        assert not nav.reached
+    nav.set_goal(Goal(3.0, 2.5, tolerance=0.25))  # a new goal starts its count afresh
+    assert nav.status == "following" and nav._recoveries_at == []
+
+
+def test_velocity_mode_gives_a_goal_up_after_max_recoveries_in_one_spot():
+    grid = snapshot(open_room())
+    nav = Navigator(NavigatorConfig(max_recoveries=2))
+    nav.set_goal(Goal(4.0, 2.5))
+    pose = Pose2D(1.0, 2.5, 0.0)
+    for _ in range(200):  # the robot never moves
+        cmd = nav.step_velocity(grid, pose, dt=0.1)
+        if nav.status == "stuck":
+            break
+    assert nav.status == "stuck" and cmd.v == 0.0 and cmd.omega == 0.0 and nav.n_recoveries == 1
 
 
 def test_resending_the_same_goal_changes_nothing():
