@@ -36,6 +36,7 @@ class FakeObject:
     confidence: float = 0.9
     n_obs: int = 1
     anchor_ids: tuple = ()
+    points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # (N, 3) world
 
 
 def obj(oid: int, label: str, x: float, y: float, n_obs: int = 1, conf: float = 0.9) -> FakeObject:

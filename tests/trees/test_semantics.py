@@ -793,6 +793,42 @@ def test_approach_goes_to_a_ring_cell_when_the_straight_way_in_is_blocked_or_too
     assert after is not None and after.kind == "approach" and not after.straight
 
 
+def test_approach_measures_to_the_objects_points_when_told_to(tmp_path):
+    """ProcTHOR val/5/2: at a round plant's diagonal the robot judged itself 0.88 m from the
+    plant's box (its corner) while the nearest of the plant's own points was 1.05 m off, and
+    stopped 1.06 m from the plant. ``measure: points`` judges the distance by the points (their
+    2% quantile): here 1.06 m, so the robot steps straight in toward the nearest point; by the
+    box, 0.85 m, it is already within the 0.9 m ring and goes to a ring cell instead."""
+    from dataclasses import replace as _replace
+
+    angles = np.linspace(0.0, 2.0 * math.pi, 200, endpoint=False)
+    circle = np.stack([5.0 + 0.5 * np.cos(angles), 5.0 + 0.5 * np.sin(angles), np.full(200, 0.4)], axis=1)
+    plant = _replace(obj(3, "bed", 5.0, 5.0), points=circle)
+    pose = Pose2D(3.9, 3.9, math.pi / 4)
+
+    def first_goal(measure: str):
+        ctx = _ctx(Clock())
+        ctx.world = world(pose, [plant])
+        tree = _confirmed_then(tmp_path, ctx, f"Approach: {{distance: 0.9, inner_margin: 0.0, measure: {measure}}}")
+        assert tree.tick() == S.RUNNING
+        return _node(tree, "Approach"), [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+
+    approach, goal = first_goal("points")
+    gap, near = approach._gap(approach.read("target"))
+    assert gap == pytest.approx(math.hypot(1.1, 1.1) - 0.5, abs=0.03)
+    assert goal.straight and math.hypot(goal.x - 5.0, goal.y - 5.0) == pytest.approx(0.5, abs=1e-6)
+    approach, goal = first_goal("box")
+    assert approach._gap(approach.read("target"))[0] == pytest.approx(math.hypot(0.6, 0.6), abs=1e-9)
+    assert not goal.straight and goal.kind == "approach"
+    bare = obj(3, "bed", 5.0, 5.0)  # no points (a hand-made node): the box decides
+    ctx = _ctx(Clock())
+    ctx.world = world(pose, [bare])
+    tree = _confirmed_then(tmp_path, ctx, "Approach: {distance: 0.9, measure: points}")
+    tree.tick()
+    approach = _node(tree, "Approach")
+    assert approach._gap(approach.read("target"))[0] == pytest.approx(math.hypot(0.6, 0.6), abs=1e-9)
+
+
 def test_approach_counts_rocking_near_its_cell_as_a_stall(tmp_path):
     """Gibson Woodbine/0/1 (0.9 m ring): the robot rocked 0.2-0.45 m from an approach cell it never
     reached for 480 steps; VerifyTarget's 0.35 m "there, glancing" allowance kept the stall clock
