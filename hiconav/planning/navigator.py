@@ -368,15 +368,13 @@ class Navigator:
         between two headings in one spot for 16 s of clock (two frontiers of 8 s each). Failing
         the goal hands the choice back to the mission, which tries the next frontier or cell."""
         cfg = self.config
-        self._recoveries_at.append((pose.x, pose.y))
         if cfg.max_recoveries <= 0:
             return False
+        self._recoveries_at.append((pose.x, pose.y))
         near = sum(1 for x, y in self._recoveries_at if math.hypot(pose.x - x, pose.y - y) <= cfg.give_up_m)
         if near < cfg.max_recoveries:
             return False
-        self.status = "stuck"
-        self._recovery.clear()
-        self._vel_recovery.clear()
+        self.status = "stuck"  # both callers ask only with no recovery under way
         log.info("navigator: %d recoveries at (%.2f, %.2f) for this goal: giving it up", near, pose.x, pose.y)
         return True
 

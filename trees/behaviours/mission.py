@@ -1173,8 +1173,7 @@ class Approach(_GoToObject):
         if not wall_clear(grid, ring_xy[None, :], centre, [(lo, hi), *self._furniture(cand)],
                           heights=self._wall_heights(cand))[0]:
             return False
-        if not self._creep(cand):
-            return False
+        self._creep(cand, (gap, near))  # beyond the distance, so it always sends
         self._straight = True
         self.context.log(f"#{cand.object_id} {gap:.2f} m off, the way in clear: stepping straight in")
         return True
@@ -1187,7 +1186,7 @@ class Approach(_GoToObject):
         self._seq = self.context.send_goal(Goal(pose.x, pose.y, _facing(np.array([pose.x, pose.y]), cand.center),
                                                 0.5, "look", cand.object_id))
 
-    def _creep(self, cand: Candidate) -> bool:
+    def _creep(self, cand: Candidate, measured: tuple[float, np.ndarray] | None = None) -> bool:
         """Settled on a ring wider than ``distance``, or stopped by the navigator's tolerance short of
         a cell's ring: go straight toward the box's nearest point until
         within ``distance`` of it (a step may end nearer), through cells the map does not know. The camera sees no floor nearer
@@ -1195,8 +1194,9 @@ class Approach(_GoToObject):
         no approach cell lies there; on Gibson five robots stopped 1.0-1.1 m from their target,
         0.96 m from its box on their own map (Ranchester/0/1), where a real robot inches closer.
         The goal is ``straight``: the robot steps toward it until a step is blocked, without a plan
-        on the map's coarser margins. False when the robot is already that close."""
-        gap, near = self._gap(cand)
+        on the map's coarser margins. False when the robot is already that close. ``measured``:
+        ``_gap(cand)`` when the caller has it already."""
+        gap, near = self._gap(cand) if measured is None else measured
         distance = self.param("distance")
         if gap <= distance:
             return False
