@@ -1282,7 +1282,7 @@ def test_a_no_view_point_deferral_lapses_once_the_map_around_the_candidate_grows
     cell, and its 30 s deferral sent the robot 39 m about the house, past the plant. Once the
     known free floor within 2 m of the candidate has grown by remap_area_m2 it is due again (and
     the deferral does not count toward max_deferrals)."""
-    clock, ctx, grid, tree = _verify_beyond_the_known(tmp_path, 2.0, "defer_s: 30, max_deferrals: 2, closer_moves: 0")
+    clock, ctx, grid, tree = _verify_beyond_the_known(tmp_path, 2.0, "defer_s: 30, max_deferrals: 2, closer_moves: 0, unknown_moves: 0")
     assert tree.tick() == S.FAILURE
     assert ctx.rejections[-1] == (3, "no reachable view point") and ctx.excluded(3)
     clock.t = 1.0
@@ -1292,7 +1292,7 @@ def test_a_no_view_point_deferral_lapses_once_the_map_around_the_candidate_grows
     assert not ctx.excluded(3)
     assert any("map around it grew by 1.2 m^2" in e for e in ctx.events)
     # a second map deferral is not the max_deferrals-th: the candidate stays deferred, not rejected
-    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, max_deferrals: 2, closer_moves: 0}")
+    tree = _confirmed_then(tmp_path, ctx, "VerifyTarget: {defer_s: 30, max_deferrals: 2, closer_moves: 0, unknown_moves: 0}")
     ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
     assert tree.tick() == S.FAILURE
     assert 3 not in ctx.rejected and ctx.remaps[3] == 2
@@ -1311,6 +1311,35 @@ def test_with_no_view_cell_on_the_map_verify_closes_in_on_the_candidate_before_d
     ctx.world = world(Pose2D(goal.goal.x, goal.goal.y, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
     ctx.nav = NavStatus(goal.seq, "reached", 0.0)
     assert tree.tick() == S.FAILURE  # still no view cell, and its one closer move is spent
+    assert ctx.rejections[-1] == (3, "no reachable view point")
+
+
+@pytest.mark.parametrize("unknown_moves", [1, 0])
+def test_with_the_floor_by_the_candidate_cut_off_by_unknown_floor_verify_heads_through_it(tmp_path, unknown_moves):
+    """Gibson Forkland/0/0: furniture cut the known floor by a sofa 4 m off from the robot's, and
+    its deferral sent the robot 15 m about the house before it came back. With no view cell
+    reachable on the known map and no closer cell, VerifyTarget heads for a view cell on the
+    floor known by the candidate through unknown floor (``unknown_moves`` times); a goal that
+    fails there defers it as before."""
+    from .fakes import open_grid
+
+    clock = Clock()
+    ctx = _ctx(clock)
+    grid = open_grid()
+    grid.state[:, 30:40] = -1  # x in [3, 4) m unknown; the floor beyond, by the bed, is known
+    ctx.world = world(Pose2D(1.0, 2.0, 0.0), [obj(3, "bed", 6.0, 6.0, n_obs=5)], grid=grid)
+    tree = _confirmed_then(tmp_path, ctx, f"VerifyTarget: {{defer_s: 30, closer_moves: 0, unknown_moves: {unknown_moves}}}")
+    if unknown_moves == 0:
+        assert tree.tick() == S.FAILURE and ctx.rejections[-1] == (3, "no reachable view point")
+        return
+    assert tree.tick() == S.RUNNING
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    g = goal.goal
+    assert g.through_unknown and g.kind == "approach" and g.ref_id == 3 and g.x >= 4.0
+    assert math.hypot(max(abs(g.x - 6.0) - 0.5, 0.0), max(abs(g.y - 6.0) - 0.5, 0.0)) <= 1.2  # a view cell
+    assert not ctx.rejections and any("through unknown floor" in e for e in ctx.events)
+    ctx.nav = NavStatus(goal.seq, "failed", 0.0)
+    assert tree.tick() == S.FAILURE  # the way turned out closed, and its one move is spent
     assert ctx.rejections[-1] == (3, "no reachable view point")
 
 

@@ -446,12 +446,13 @@ class _GoToObject(MissionBehaviour):
         self._go_to_cell(cand, cell, 0.2)
         return True
 
-    def _go_to_cell(self, cand: Candidate, cell: np.ndarray, tolerance: float) -> None:
+    def _go_to_cell(self, cand: Candidate, cell: np.ndarray, tolerance: float, through_unknown: bool = False) -> None:
         """Send the goal ``cell`` (world xy) facing the candidate, and restart the stall clock."""
         self._cell = cell
         self._progress: tuple[float, float] | None = None  # (best distance to the cell, clock time)
         self._seq = self.context.send_goal(Goal(float(cell[0]), float(cell[1]), _facing(cell, cand.center),
-                                                tolerance, "approach", cand.object_id))
+                                                tolerance, "approach", cand.object_id,
+                                                through_unknown=through_unknown))
 
     # a goal cell the robot has come no nearer to (by 0.25 m) for this many clock seconds counts
     # as failed: a navigator rocking in a doorway held ProcTHOR val/52/1 for 350 steps, while
@@ -540,6 +541,9 @@ class VerifyTarget(_GoToObject):
                                   "before deferring it (0: defer at once)"),
         "closer_min_gain": Param(float, 1.0, minimum=0.1, maximum=10.0,
                                  doc="a closer cell lies this much nearer the candidate's box than the robot"),
+        "unknown_moves": Param(int, 1, minimum=0, maximum=100,
+                               doc="with no view cell reachable on the known map and no closer cell, head for a "
+                                   "view cell through unknown floor this many times before deferring (0: never)"),
         "switch_margin": Param(float, 1.0, minimum=0.0, maximum=100.0,
                                doc="on the way to the candidate, verify instead a candidate that comes this "
                                    "much nearer the robot (m; 0: never switch)"),
@@ -576,6 +580,7 @@ class VerifyTarget(_GoToObject):
         self._glance = 0
         self._closing = False  # the goal in flight is a closer cell (``_send_closer``), not a view cell
         self._closer_moves = 0
+        self._unknown_moves = 0
         if self._cand is not None and self.context.verify:
             self._send(self._cand, self._goal_distance(self._cand))
 
@@ -702,6 +707,33 @@ class VerifyTarget(_GoToObject):
         self._go_to_cell(cand, cell, 0.3)
         ctx.log(f"no view cell of #{cand.object_id} on the map yet: closing in to "
                 f"({cell[0]:.2f}, {cell[1]:.2f}), {gap:.1f} m from it now")
+        return True
+
+    def _send_through_unknown(self, cand: Candidate) -> bool:
+        """No view cell is reachable on the known map and no closer cell either: head for a view
+        cell (free on the map, clear of walls toward the candidate) on a path that may cross
+        unknown floor, at most ``unknown_moves`` times; False when there is none.
+
+        Furniture between the robot and a sofa seen 4 m off cut the free floor by the sofa from
+        the robot's; deferred, the sofa waited while the robot explored elsewhere by the plan's
+        order, and came back past it 15 m later (Gibson Forkland/0/0). The way round, through a
+        room the camera had not yet seen, is what a person takes: the navigator replans as the
+        floor shows, and a way that turns out closed fails the goal, and the candidate is deferred
+        as before."""
+        ctx = self.context
+        pose = ctx.pose
+        if ctx.grid is None or pose is None or self._unknown_moves >= self.param("unknown_moves"):
+            return False
+        robot = np.array([pose.x, pose.y])
+        cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, self._goal_distance(cand), self._excluded,
+                             furniture=self._furniture(cand), strict_walls=True, sight=self._sight(cand),
+                             wall_heights=self._wall_heights(cand), connected=False)
+        if cell is None:
+            return False
+        self._unknown_moves += 1
+        self._go_to_cell(cand, cell, 0.2, through_unknown=True)
+        ctx.log(f"no view cell of #{cand.object_id} reachable on the known map: heading for "
+                f"({cell[0]:.2f}, {cell[1]:.2f}) through unknown floor")
         return True
 
     def _support_confidence(self, cand: Candidate) -> float:
@@ -937,6 +969,9 @@ class VerifyTarget(_GoToObject):
             if len(self._excluded) > 3 or not self._send(current, self._goal_distance(current)):
                 if self._send_closer(current):
                     self.feedback_message = f"closing in on {cand.label} #{cand.object_id}"
+                    return Status.RUNNING
+                if self._send_through_unknown(current):
+                    self.feedback_message = f"heading for {cand.label} #{cand.object_id} through unknown floor"
                     return Status.RUNNING
                 if ctx.grid is not None and ctx.pose is not None:
                     return self._reject("no reachable view point", False, remap=True)

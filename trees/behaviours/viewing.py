@@ -21,7 +21,7 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
                   prefer_weight: float = 0.0, sight: tuple[np.ndarray, float, np.ndarray, np.ndarray] | None = None,
                   furniture: list[tuple[np.ndarray, np.ndarray]] | None = None,
                   strict_walls: bool = False, box_weight: float = 0.0,
-                  wall_heights: tuple[float, float] | None = None) -> np.ndarray | None:
+                  wall_heights: tuple[float, float] | None = None, connected: bool = True) -> np.ndarray | None:
     """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint.
 
     grid: snapshot with ``state`` (H, W) int8 (0 free), ``inflated`` (H, W) bool, ``origin`` (2,),
@@ -50,6 +50,8 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     the footprint: for a ring wider than the success distance the nearest cell to the robot lies
     on the ring's edge, 1 m out, where the object's box error decides success (Gibson stopped
     0.96-1.06 m from five targets' boxes while free cells 0.1-0.2 m nearer were known).
+    ``connected=False`` drops the first condition: any free cell will do, for a goal the robot
+    is to reach through unknown floor (``VerifyTarget._send_through_unknown``).
     """
     from scipy import ndimage
 
@@ -78,7 +80,7 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     dx = np.maximum(np.maximum(box_min[0] - x, 0.0), x - box_max[0])
     dy = np.maximum(np.maximum(box_min[1] - y, 0.0), y - box_max[1])
     ok = (np.hypot(dx, dy) <= max_distance) & free[r0:r1, c0:c1]
-    if robot_label:
+    if robot_label and connected:
         ok &= labels[r0:r1, c0:c1] == robot_label
     for ex in exclude or []:
         ok &= np.hypot(x - ex[0], y - ex[1]) > 0.3
