@@ -437,7 +437,16 @@ class _GoToObject(MissionBehaviour):
         kw = {"centre_weight": self._centre_weight(), "prefer_xy": prefer, "prefer_weight": self._prefer_weight(),
               "sight": self._sight(cand), "furniture": self._furniture(cand), "strict_walls": strict_walls,
               "box_weight": box_weight, "wall_heights": self._wall_heights(cand)}
-        cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, **kw)
+        cell = None
+        if self._in_margin(robot):
+            # the robot already stands in a passage only its radius clears (its cell inflated): a
+            # cell along that passage is no tighter than where it is. Keeping the margin sent a
+            # robot 1.0 m from a chair's box in a 0.4 m corridor 1.7 m along it, to the corridor's
+            # end, the one roomy cell in range (Gibson Woodbine/0/1)
+            cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, tight=True,
+                                 prefer_roomy=False, **kw)
+        if cell is None:
+            cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, **kw)
         if cell is None:  # furniture around it: a cell only the robot radius clears will do
             cell = approach_cell(ctx.grid, cand.box_min, cand.box_max, robot, distance, self._excluded, tight=True,
                                  **kw)
@@ -445,6 +454,11 @@ class _GoToObject(MissionBehaviour):
             return False
         self._go_to_cell(cand, cell, 0.2)
         return True
+
+    def _in_margin(self, robot: np.ndarray) -> bool:
+        """True when cells only the robot radius clears may be weighed as the others (see
+        Approach); False here."""
+        return False
 
     def _go_to_cell(self, cand: Candidate, cell: np.ndarray, tolerance: float, through_unknown: bool = False) -> None:
         """Send the goal ``cell`` (world xy) facing the candidate, and restart the stall clock."""
@@ -1038,6 +1052,20 @@ class Approach(_GoToObject):
 
     def _centre_weight(self) -> float:
         return self.param("centre_weight")
+
+    def _in_margin(self, robot: np.ndarray) -> bool:
+        """The robot's own cell lies in the map's inflation margin (or on its lethal layer, which
+        the map's phase grows past the robot in a narrow passage): it stands in a passage only its
+        radius clears."""
+        grid = self.context.grid
+        if grid is None:
+            return False
+        res, origin = float(grid.resolution), np.asarray(grid.origin, dtype=np.float64)
+        r, c = int((robot[1] - origin[1]) / res), int((robot[0] - origin[0]) / res)
+        inflated = np.asarray(grid.inflated)
+        if not (0 <= r < inflated.shape[0] and 0 <= c < inflated.shape[1]):
+            return False
+        return bool(inflated[r, c])
 
     def initialise(self) -> None:
         self._start = self.context.now()

@@ -21,7 +21,8 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
                   prefer_weight: float = 0.0, sight: tuple[np.ndarray, float, np.ndarray, np.ndarray] | None = None,
                   furniture: list[tuple[np.ndarray, np.ndarray]] | None = None,
                   strict_walls: bool = False, box_weight: float = 0.0,
-                  wall_heights: tuple[float, float] | None = None, connected: bool = True) -> np.ndarray | None:
+                  wall_heights: tuple[float, float] | None = None, connected: bool = True,
+                  prefer_roomy: bool = True) -> np.ndarray | None:
     """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint.
 
     grid: snapshot with ``state`` (H, W) int8 (0 free), ``inflated`` (H, W) bool, ``origin`` (2,),
@@ -51,7 +52,9 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     on the ring's edge, 1 m out, where the object's box error decides success (Gibson stopped
     0.96-1.06 m from five targets' boxes while free cells 0.1-0.2 m nearer were known).
     ``connected=False`` drops the first condition: any free cell will do, for a goal the robot
-    is to reach through unknown floor (``VerifyTarget._send_through_unknown``).
+    is to reach through unknown floor (``VerifyTarget._send_through_unknown``). With ``tight``,
+    ``prefer_roomy=False`` weighs cells only the robot radius clears as the others (for a robot
+    that already stands in such a passage).
     """
     from scipy import ndimage
 
@@ -86,7 +89,7 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
         ok &= np.hypot(x - ex[0], y - ex[1]) > 0.3
     if not np.any(ok):
         return None
-    if tight and np.any(ok & roomy[r0:r1, c0:c1]):
+    if tight and prefer_roomy and np.any(ok & roomy[r0:r1, c0:c1]):
         ok &= roomy[r0:r1, c0:c1]
     centre = 0.5 * (np.asarray(box_min, dtype=np.float64)[:2] + np.asarray(box_max, dtype=np.float64)[:2])
     if furniture is not None:
