@@ -1111,28 +1111,34 @@ def test_verify_out_of_range_after_the_box_moved_goes_to_a_new_cell_instead_of_g
     assert goal.kind == "approach" and math.hypot(goal.x - 7.5, goal.y - 7.5) < 2.0
 
 
-def test_approach_from_inside_a_narrow_passage_weighs_its_cells_as_roomy_ones(tmp_path):
-    """Gibson Woodbine/0/1: 1.0 m from a chair's box in a 0.4 m corridor, every cell of which lay in
-    the map's inflation margin, Approach drove 1.7 m along it to the corridor's end, the one cell
-    in range that kept the margin. A robot already in the margin weighs the passage's cells as the
-    others, and steps in where it is."""
+def _corridor_to_the_bed():
+    """A 0.8 m corridor (y 3.6-4.4) below the bed at (5, 5), all of it in the map's inflation margin
+    up to x = 5.6 (the robot radius clears it), roomy from there on."""
     from .fakes import FakeGrid
 
     state = np.zeros((100, 100), dtype=np.int8)
     state[0, :] = state[-1, :] = state[:, 0] = state[:, -1] = 1
-    state[:36, :] = 1  # a wall below the corridor (y < 3.6)
-    state[44:, :] = 1  # the bed's side of it, from y = 4.4
+    state[:36, :] = 1
+    state[44:, :] = 1
     inflated = state == 1
-    inflated[36:44, :56] = True  # the corridor (y 3.6-4.4) keeps no margin up to x = 5.6
+    inflated[36:44, :56] = True
     grid = FakeGrid(state, inflated)
-    grid.lethal = state == 1  # the robot radius clears the corridor; the margin does not
+    grid.lethal = state == 1
+    return grid
+
+
+@pytest.mark.parametrize("leaf", ["Approach: {distance: 0.8}", "VerifyTarget: {}"])
+def test_from_inside_a_narrow_passage_the_robot_weighs_its_cells_as_roomy_ones(tmp_path, leaf):
+    """Gibson Woodbine/0/1: 1.0 m from a chair's box in a 0.4 m corridor, every cell of which lay in
+    the map's inflation margin, Approach drove 1.7 m along it to the corridor's end, the one cell
+    in range that kept the margin. A robot already in the margin weighs the passage's cells as the
+    others (Approach's cells and VerifyTarget's view cells), and stops where it is nearest."""
     ctx = _ctx(Clock())
-    ctx.world = world(Pose2D(2.9, 3.8, 0.0), [obj(3, "bed", 5.0, 5.0)], grid=grid)  # 1.75 m off: no straight step
-    tree = _confirmed_then(tmp_path, ctx, "Approach: {distance: 0.8}")
+    ctx.world = world(Pose2D(2.9, 3.8, 0.0), [obj(3, "bed", 5.0, 5.0, n_obs=5)], grid=_corridor_to_the_bed())
+    tree = _confirmed_then(tmp_path, ctx, leaf)
     assert tree.tick() == S.RUNNING
     goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
     assert goal.kind == "approach" and goal.x < 5.0  # not the roomy cells from x = 5.6 on
-    assert math.hypot(max(4.5 - goal.x, 0.0, goal.x - 5.5), max(4.5 - goal.y, 0.0)) <= 0.8
 
 
 def test_requalify_observations_zero_keeps_a_label_flip_deferred_for_its_time():

@@ -455,10 +455,22 @@ class _GoToObject(MissionBehaviour):
         self._go_to_cell(cand, cell, 0.2)
         return True
 
+    # weigh a passage's cells as roomy ones when the robot already stands in it (see _in_margin)
+    PASSAGE_CELLS = False
+
     def _in_margin(self, robot: np.ndarray) -> bool:
-        """True when cells only the robot radius clears may be weighed as the others (see
-        Approach); False here."""
-        return False
+        """With ``PASSAGE_CELLS``: the robot's own cell lies in the map's inflation margin (or on
+        its lethal layer, which the map's phase grows past the robot in a narrow passage): it
+        stands in a passage only its radius clears."""
+        grid = self.context.grid
+        if not self.PASSAGE_CELLS or grid is None:
+            return False
+        res, origin = float(grid.resolution), np.asarray(grid.origin, dtype=np.float64)
+        r, c = int((robot[1] - origin[1]) / res), int((robot[0] - origin[0]) / res)
+        inflated = np.asarray(grid.inflated)
+        if not (0 <= r < inflated.shape[0] and 0 <= c < inflated.shape[1]):
+            return False
+        return bool(inflated[r, c])
 
     def _go_to_cell(self, cand: Candidate, cell: np.ndarray, tolerance: float, through_unknown: bool = False) -> None:
         """Send the goal ``cell`` (world xy) facing the candidate, and restart the stall clock."""
@@ -570,6 +582,7 @@ class VerifyTarget(_GoToObject):
     }
     WRITES = ("target",)
     READS = ()
+    PASSAGE_CELLS = True
     # degrees from facing the target: 70 degrees apart, so that each glance passes the memory's
     # anchor gate (delta_theta = 45 deg) and adds a view, while the target stays in the field of view
     _GLANCES = (35.0, -35.0)
@@ -1053,19 +1066,7 @@ class Approach(_GoToObject):
     def _centre_weight(self) -> float:
         return self.param("centre_weight")
 
-    def _in_margin(self, robot: np.ndarray) -> bool:
-        """The robot's own cell lies in the map's inflation margin (or on its lethal layer, which
-        the map's phase grows past the robot in a narrow passage): it stands in a passage only its
-        radius clears."""
-        grid = self.context.grid
-        if grid is None:
-            return False
-        res, origin = float(grid.resolution), np.asarray(grid.origin, dtype=np.float64)
-        r, c = int((robot[1] - origin[1]) / res), int((robot[0] - origin[0]) / res)
-        inflated = np.asarray(grid.inflated)
-        if not (0 <= r < inflated.shape[0] and 0 <= c < inflated.shape[1]):
-            return False
-        return bool(inflated[r, c])
+    PASSAGE_CELLS = True  # a robot 1.0 m from a chair in a 0.4 m corridor drove 1.7 m along it (Woodbine/0/1)
 
     def initialise(self) -> None:
         self._start = self.context.now()
