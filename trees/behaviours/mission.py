@@ -455,15 +455,12 @@ class _GoToObject(MissionBehaviour):
         self._go_to_cell(cand, cell, 0.2)
         return True
 
-    # weigh a passage's cells as roomy ones when the robot already stands in it (see _in_margin)
-    PASSAGE_CELLS = False
-
     def _in_margin(self, robot: np.ndarray) -> bool:
-        """With ``PASSAGE_CELLS``: the robot's own cell lies in the map's inflation margin (or on
-        its lethal layer, which the map's phase grows past the robot in a narrow passage): it
-        stands in a passage only its radius clears."""
+        """The robot's own cell lies in the map's inflation margin (or on its lethal layer, which
+        the map's phase grows past the robot in a narrow passage): it stands in a passage only its
+        radius clears."""
         grid = self.context.grid
-        if not self.PASSAGE_CELLS or grid is None:
+        if grid is None:
             return False
         res, origin = float(grid.resolution), np.asarray(grid.origin, dtype=np.float64)
         r, c = int((robot[1] - origin[1]) / res), int((robot[0] - origin[0]) / res)
@@ -582,7 +579,6 @@ class VerifyTarget(_GoToObject):
     }
     WRITES = ("target",)
     READS = ()
-    PASSAGE_CELLS = True
     # degrees from facing the target: 70 degrees apart, so that each glance passes the memory's
     # anchor gate (delta_theta = 45 deg) and adds a view, while the target stays in the field of view
     _GLANCES = (35.0, -35.0)
@@ -1065,8 +1061,6 @@ class Approach(_GoToObject):
 
     def _centre_weight(self) -> float:
         return self.param("centre_weight")
-
-    PASSAGE_CELLS = True  # a robot 1.0 m from a chair in a 0.4 m corridor drove 1.7 m along it (Woodbine/0/1)
 
     def initialise(self) -> None:
         self._start = self.context.now()
