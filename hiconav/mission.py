@@ -370,7 +370,8 @@ class _RobotTracker:
         return episode_metrics(self.episode, final_distance=self.goal.distance(r.pose.xy),
                                path_length=float(r.path_length), steps=int(r.steps), stopped=bool(r.stopped),
                                collisions=0, shortest_to_success=self.shortest_to_success,
-                               config=self.config)
+                               config=self.config,
+                               final_to_success=self.goal.to_success(r.pose.xy, self.config.success_distance))
 
 
 def _run_robot(runtime: Any, robot: Any, max_time: float) -> Any:

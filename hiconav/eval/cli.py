@@ -97,17 +97,21 @@ def eval(
     config_file: Path | None = typer.Option(None, "--config", help="Settings YAML applied to every preset; --set wins."),
     stuck_window: int = typer.Option(50, "--stuck-window", min=1, help="Steps without progress that count as stuck."),
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show the progress bar."),
+    scenes: str | None = typer.Option(None, "--scenes", help="Gibson floors: 'tune' (the alphabetically first 13 scenes), 'report' (the other 12) or Scene,Scene."),
+    dry_run: bool = typer.Option(False, "--dry-run", help="Validate every episode without running it; print a JSON line of counts."),
 ) -> None:
     """Run ObjectNav episodes in parallel and write metrics, the failure taxonomy and a report."""
     from hiconav.eval.config import EvalConfig
     from hiconav.eval.presets import resolve_presets
     from hiconav.eval.runner import evaluate
-    from hiconav.eval.sources import gibson_source, procthor_source
+    from hiconav.eval.sources import gibson_source, invalid_reason, procthor_source, validate_spec
 
     if (houses is None) == (maps is None):
         raise ConfigError("give exactly one input: --houses FILE.jsonl.gz or --maps FILE.pbz2", field="--houses/--maps")
     if episodes and maps is None:
         raise ConfigError("--episodes (Habitat episode files) goes with --maps", field="--episodes")
+    if scenes and maps is None:
+        raise ConfigError("--scenes selects Gibson floors: it goes with --maps", field="--scenes")
     if backend not in ("local", "ray"):
         raise ConfigError(f"unknown backend {backend!r}; known: local, ray", field="--backend")
     if address and backend != "ray":
@@ -127,18 +131,46 @@ def eval(
               "episodes": [str(Path(p).resolve()) for p in episodes or []],
               "episodes_per_house": episodes_per_house, "seed": seed, "limit": limit,
               "episode_rules": None if episodes else EPISODE_RULES}
+    if scenes:
+        source["scenes"] = scenes
+    def build() -> list[Any]:
+        if houses is not None:
+            return procthor_source(houses, episodes_per_house, seed=seed, limit=limit, workers=n_workers)
+        return gibson_source(maps, episodes, episodes_per_house=episodes_per_house, seed=seed, limit=limit,
+                             workers=n_workers, scenes=scenes)
+
+    if dry_run:  # nothing is written: validate and count
+        specs = build()
+        errors = [validate_spec(spec) for spec in specs]
+        invalid: dict[str, int] = {}
+        for error in errors:
+            if error:
+                invalid[invalid_reason(error)] = invalid.get(invalid_reason(error), 0) + 1
+        for spec, error in zip(specs, errors, strict=True):
+            if error:
+                typer.echo(f"invalid {spec.episode_id}: {error}")
+        valid = sum(1 for error in errors if not error)
+        typer.echo(json.dumps({"episodes": len(specs), "valid": valid, "invalid": dict(sorted(invalid.items()))}))
+        if valid == 0:
+            raise DataError(f"no episode of the input is valid ({len(specs)} episodes: "
+                            f"{', '.join(f'{k}: {v}' for k, v in sorted(invalid.items())) or 'none'})",
+                            field="--houses/--maps")
+        return
     saved = _saved_source(Path(out))
     _check_resumable(Path(out), saved, source)
     specs = _cached_specs(Path(out), saved, source)
     if specs is None:
-        if houses is not None:
-            specs = procthor_source(houses, episodes_per_house, seed=seed, limit=limit, workers=n_workers)
-        else:
-            specs = gibson_source(maps, episodes, episodes_per_house=episodes_per_house, seed=seed, limit=limit,
-                                  workers=n_workers)
+        specs = build()
         _save_specs(Path(out), source, specs)
     if not specs:
         raise DataError("the input holds no episode", field="--houses/--maps")
+    if all(spec.error for spec in specs):
+        reasons: dict[str, int] = {}
+        for spec in specs:
+            reasons[invalid_reason(spec.error)] = reasons.get(invalid_reason(spec.error), 0) + 1
+        raise DataError(f"no episode of the input is valid ({len(specs)} episodes: "
+                        f"{', '.join(f'{k}: {v}' for k, v in sorted(reasons.items()))}); "
+                        "run with --dry-run to list them", field="--houses/--maps")
     command = "hiconav eval " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if len(sys.argv) > 2 else ""
     summary = evaluate(specs, out, config, run_info={"command": command,
                                                      "source": str(houses or maps), "episodes": len(specs)})

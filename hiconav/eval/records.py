@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import os
 from collections.abc import Iterable, Iterator
 from dataclasses import asdict, dataclass, field, fields
@@ -73,9 +74,16 @@ class EpisodeRecord:
         return (self.preset, self.episode_id)
 
     def to_json(self) -> dict[str, Any]:
+        """The JSON dict. JSON has no infinity or NaN: every non-finite number (an unreachable
+        goal's infinite distance, a NaN from a broken run) is written as null, and its path and
+        what it was are listed in ``nonfinite`` ({"geodesic_distance": "inf"}), so that reading
+        the record back restores it. A DTS of null alone means an unknown distance to success."""
         data = asdict(self)
-        if not math.isfinite(data["dts"]):
-            data["dts"] = None  # JSON has no infinity; None = unknown distance to success
+        reasons: dict[str, str] = {}
+        data = _finite(data, "", reasons)
+        reasons.pop("dts", None)  # null DTS is the documented "unknown", no reason needed
+        if reasons:
+            data["nonfinite"] = reasons
         return data
 
     @staticmethod
@@ -84,9 +92,11 @@ class EpisodeRecord:
         missing = [name for name in ("episode_id", "house", "target") if name not in data]
         if missing:
             raise DataError(f"episode record lacks {', '.join(missing)}", file=file, line=line)
-        kwargs = {k: v for k, v in data.items() if k in known}
+        nonfinite = data.get("nonfinite") if isinstance(data.get("nonfinite"), dict) else {}
+        kwargs = {k: (_restore(nonfinite[k]) if k in nonfinite and v is None else v)
+                  for k, v in data.items() if k in known}
         extra = dict(kwargs.pop("extra", None) or {})
-        extra.update({k: v for k, v in data.items() if k not in known})
+        extra.update({k: v for k, v in data.items() if k not in known and k != "nonfinite"})
         if kwargs.get("dts") is None:
             kwargs["dts"] = math.inf
         return EpisodeRecord(**kwargs, extra=extra)
@@ -113,6 +123,25 @@ class EpisodeRecord:
         for name in WALL_FIELDS:
             data.pop(name, None)
         return data
+
+
+def _finite(value: Any, path: str, reasons: dict[str, str]) -> Any:
+    """``value`` with every non-finite float replaced by None (its path noted in ``reasons``)."""
+    if isinstance(value, numbers.Real) and not isinstance(value, numbers.Integral):
+        number = float(value)
+        if not math.isfinite(number):
+            reasons[path] = "nan" if math.isnan(number) else ("inf" if number > 0 else "-inf")
+            return None
+        return value
+    if isinstance(value, dict):
+        return {k: _finite(v, f"{path}.{k}" if path else str(k), reasons) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v, f"{path}[{i}]", reasons) for i, v in enumerate(value)]
+    return value
+
+
+def _restore(reason: Any) -> float:
+    return {"inf": math.inf, "-inf": -math.inf}.get(str(reason), math.nan)
 
 
 def dumps(record: EpisodeRecord) -> str:

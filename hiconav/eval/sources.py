@@ -18,7 +18,6 @@ import bz2
 import functools
 import gzip
 import json
-import os
 import pickle
 import zlib
 from collections.abc import Iterable, Iterator, Sequence
@@ -101,32 +100,10 @@ class EpisodeSpec:
 @functools.lru_cache(maxsize=8)
 def load_house_cached(spec: str) -> Any:
     """``hiconav.sim.load_house(spec)``, memoised per process (each worker loads a house once).
-
-    ``<file.jsonl.gz>#<index>`` (a house of a multi-house ProcTHOR file outside the data root):
-    if the simulator does not take that spec itself, the fallback extracts that line to a
-    one-house file in a per-process temporary folder and loads it by path."""
+    Specs of houses in data files anywhere on disk: ``FILE.jsonl.gz#N``, ``FILE.pbz2#Scene/floor``."""
     from hiconav.sim import load_house
 
-    path, sep, index = spec.rpartition("#")
-    if not sep or not index.isdigit() or not Path(path).is_file():
-        return load_house(spec)
-    try:
-        return load_house(spec)
-    except HiconavError:
-        pass
-    # Fallback (labelled): the simulator loads one-house files by path.
-    import tempfile
-
-    opener = gzip.open if path.endswith(".gz") else open
-    with opener(path, "rt", encoding="utf-8") as fh:
-        line = next((text for i, text in enumerate(fh) if i == int(index)), None)
-    if line is None:
-        raise DataError(f"no house at line {int(index) + 1}", file=path, field="house")
-    folder = Path(tempfile.gettempdir()) / f"hiconav-eval-houses-{os.getpid()}"
-    folder.mkdir(exist_ok=True)
-    single = folder / f"{Path(path).name.split('.')[0]}-{index}.json"
-    single.write_text(line, encoding="utf-8")
-    return load_house(str(single))
+    return load_house(spec)
 
 
 def derive_seed(base_seed: int, name: str) -> int:
@@ -249,13 +226,38 @@ def _take(specs: Iterable[EpisodeSpec], limit: int | None) -> list[EpisodeSpec]:
 # ------------------------------------------------------------------------------------------ Gibson
 
 
-def gibson_house_specs(maps_file: str | Path) -> list[str]:
+#: The held-out protocol: parameters are chosen on the floors of the alphabetically first
+#: ``TUNE_SCENES`` scenes of a maps file ("tune"); figures are reported on the others ("report").
+TUNE_SCENES = 13
+
+
+def gibson_house_specs(maps_file: str | Path, scenes: str | None = None) -> list[str]:
     """House spec strings of every (scene, floor) in a Gibson semantic-map ``*.pbz2`` file.
 
     The data root's file maps to ``gibson:<Scene>/<floor>``; any other to ``<path>#<Scene>/<floor>``.
+    ``scenes``: "tune" (the alphabetically first ``TUNE_SCENES`` scenes), "report" (the others),
+    or a comma-separated list of scene names; None for all.
     """
     path = _require_file(maps_file, "--maps").resolve()
-    return list(_gibson_house_specs(path, path.stat().st_mtime_ns))
+    specs = list(_gibson_house_specs(path, path.stat().st_mtime_ns))
+    if not scenes:
+        return specs
+    names = sorted({_scene_of(spec) for spec in specs})
+    if scenes == "tune":
+        wanted = set(names[:TUNE_SCENES])
+    elif scenes == "report":
+        wanted = set(names[TUNE_SCENES:])
+    else:
+        wanted = {name.strip() for name in scenes.split(",") if name.strip()}
+        unknown = sorted(wanted - set(names))
+        if unknown:
+            raise DataError(f"unknown scene(s) {', '.join(unknown)}; the maps file has: {', '.join(names)}",
+                            file=str(path), field="--scenes")
+    return [spec for spec in specs if _scene_of(spec) in wanted]
+
+
+def _scene_of(house_spec: str) -> str:
+    return house_spec.rpartition("#")[2].removeprefix("gibson:").split("/")[0]
 
 
 @functools.lru_cache(maxsize=4)
@@ -288,8 +290,10 @@ def habitat_episode_files(paths: Sequence[str | Path]) -> list[Path]:
     return files
 
 
-def _habitat_groups(path: Path) -> dict[tuple[str, int], list[dict[str, Any]]]:
-    """(scene, floor) -> the raw episodes of one Habitat ObjectNav episode file."""
+def _habitat_groups(path: Path, maps_file: Path | None = None) -> dict[tuple[str, int], list[dict[str, Any]]]:
+    """(scene, floor) -> the raw episodes of one Habitat ObjectNav episode file. An episode's
+    floor is the floor of ``maps_file`` whose ``floor_height`` matches its start's height
+    (``gibson.floor_for_height``; -1 when none does), else its ``floor_id``."""
     opener = gzip.open if path.suffix == ".gz" else open
     try:
         with opener(path, "rt", encoding="utf-8") as fh:
@@ -308,32 +312,51 @@ def _habitat_groups(path: Path) -> dict[tuple[str, int], list[dict[str, Any]]]:
             floor = int(episode.get("floor_id", 0) or 0)
         except (TypeError, ValueError) as exc:
             raise DataError(f"bad floor_id: {exc}", file=str(path), field=f"episodes[{i}].floor_id") from exc
+        height = _start_height(episode)
+        if maps_file is not None and height is not None:
+            from hiconav.sim.gibson import floor_for_height, load_info
+
+            if scene in load_info(str(maps_file)):
+                found = floor_for_height(maps_file, scene, height)
+                floor = -1 if found is None else found
         groups.setdefault((scene, floor), []).append({"_index": i, **episode})
     return groups
 
 
+def _start_height(episode: dict[str, Any]) -> float | None:
+    try:
+        height = float(episode["start_position"][1])
+    except (KeyError, TypeError, ValueError, IndexError):
+        return None
+    return height if height == height else None
+
+
 def gibson_source(maps_file: str | Path, episodes: Sequence[str | Path] | None = None, *,
                   episodes_per_house: int = 3, seed: int = 0, limit: int | None = None,
-                  workers: int = 1) -> list[EpisodeSpec]:
-    """Gibson floors of ``maps_file`` with the Habitat episodes of ``episodes`` (files or folders,
-    ``hiconav.sim.load_habitat_episodes``), or, without episode files, generated episodes."""
-    house_specs = gibson_house_specs(maps_file)
+                  workers: int = 1, scenes: str | None = None) -> list[EpisodeSpec]:
+    """Gibson floors of ``maps_file`` (``scenes``: see ``gibson_house_specs``) with the Habitat
+    episodes of ``episodes`` (files or folders, ``hiconav.sim.load_habitat_episodes``), or,
+    without episode files, generated episodes."""
+    house_specs = gibson_house_specs(maps_file, scenes)
     if not episodes:
         return _take(_generated(house_specs, episodes_per_house, seed, limit, workers), limit)
     by_scene = {spec.rpartition("#")[2].removeprefix("gibson:"): spec for spec in house_specs}
-    return _take(_habitat(habitat_episode_files(episodes), by_scene), limit)
+    return _take(_habitat(habitat_episode_files(episodes), by_scene, Path(maps_file)), limit)
 
 
-def _habitat(files: list[Path], by_scene: dict[str, str]) -> Iterator[EpisodeSpec]:
+def _habitat(files: list[Path], by_scene: dict[str, str], maps_file: Path | None = None) -> Iterator[EpisodeSpec]:
     for path in files:
-        for (scene, floor), raw in sorted(_habitat_groups(path).items()):
+        for (scene, floor), raw in sorted(_habitat_groups(path, maps_file).items()):
             house_spec = by_scene.get(f"{scene}/{floor}")
             stem = f"{path.name}:{scene}/{floor}"
             if house_spec is None:
+                scenes = {key.split("/")[0] for key in by_scene}
+                why = (f"no floor of {scene} lies at the start's height" if floor < 0 and scene in scenes
+                       else f"scene {scene} floor {floor} is not in the maps file")
                 for episode in raw:
                     yield EpisodeSpec(episode_id=f"{stem}/{episode.get('episode_id', episode['_index'])}",
                                       house=f"gibson:{scene}/{floor}", target=str(episode.get("object_category", "")),
-                                      error=f"{path}: scene {scene} floor {floor} is not in the maps file")
+                                      error=f"{path} episodes[{episode['_index']}]: {why}")
                 continue
             yield from _habitat_group(path, raw, house_spec, stem)
 
@@ -374,6 +397,56 @@ def _habitat_group(path: Path, raw: list[dict[str, Any]], house_spec: str, stem:
             else:
                 spec = EpisodeSpec.from_episode(episode, episode_id=f"{stem}/{episode.episode_id}")
                 yield replace(spec, house=house_spec)
+
+
+#: Stable short reasons for invalid episodes (``--dry-run`` counts them), by a phrase of the error.
+_REASONS: tuple[tuple[str, str], ...] = (
+    ("not on the traversable area", "start off the traversable area"),
+    ("is reachable from the start", "no goal reachable from the start"),
+    ("lies at the start's height", "no floor at the start's height"),
+    ("is not in the maps file", "scene not in the maps file"),
+    ("outside the", "start outside the map"),
+    ("unknown object category", "unknown goal category"),
+    ("has no '", "goal category absent from the floor"),
+    ("start off the robot's free space", "start off the robot's free space"),
+    ("cannot load house", "house cannot be loaded"),
+    ("unknown house", "house cannot be loaded"),
+)
+
+
+def invalid_reason(error: str) -> str:
+    """The short reason class of an invalid episode's error message."""
+    for phrase, reason in _REASONS:
+        if phrase in error:
+            return reason
+    return "other: " + error.split(":")[0][:80]
+
+
+def validate_spec(spec: EpisodeSpec, *, radius: float = 0.18) -> str | None:
+    """Why ``spec`` cannot be run (an error message), or None when it can: the house loads, the
+    start lies on (or within the simulator's 0.3 m snap of) the robot's free space, and a goal's
+    success region is reachable from it. Loads the house; runs nothing."""
+    if spec.error:
+        return spec.error
+    try:
+        import math
+
+        from hiconav.sim.geodesic import GoalDistance, centre_free
+
+        house = load_house_cached(spec.house)
+        goal = GoalDistance(house, instance_ids=spec.goal_instance_ids, radius=radius)
+        free = centre_free(house, radius)
+        rc = house.nav.world_to_cell(spec.start[:2])
+        reach = 6  # cells: the simulator snaps a start to free floor within 0.3 m
+        r0, c0 = max(int(rc[0]) - reach, 0), max(int(rc[1]) - reach, 0)
+        if not house.nav.in_bounds(rc) or not free[r0:int(rc[0]) + reach + 1, c0:int(rc[1]) + reach + 1].any():
+            return f"start {list(spec.start[:2])} is not on the traversable area of {house.name} " \
+                   "(start off the robot's free space)"
+        if not math.isfinite(goal.to_success(spec.start[:2], 1.0)):
+            return f"no '{spec.target}' of {house.name} is reachable from the start {list(spec.start[:2])}"
+    except Exception as exc:  # noqa: BLE001 - bad input: reported, never aborts
+        return f"cannot load house or goals: {type(exc).__name__}: {exc}"
+    return None
 
 
 def read_specs(path: str | Path) -> list[EpisodeSpec]:

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from hiconav.errors import DataError
-from hiconav.sim.geodesic import GoalDistance, house_graph
+from hiconav.sim.geodesic import GoalDistance, distance_mask, house_graph
 from hiconav.sim.house import House
 from hiconav.sim.viewpoints import MIN_VIEW_PIXELS, viewable_instances
 from hiconav.types import Pose2D
@@ -35,8 +35,12 @@ TARGET_CATEGORIES: tuple[str, ...] = (
 
 # What decides a generated episode besides (house, n, seed); an eval output folder records it, so
 # that results of episodes generated under other rules are never resumed as if they were these.
-EPISODE_RULES = "goals: instances with >= 150 px from a view point; footprints at least one cell wide"
+EPISODE_RULES = ("goals: instances with >= 150 px from a view point; footprints at least one cell wide; "
+                 "gibson: SemExp's protocol (channel 0 is the centre's free space, fast marching, "
+                 "every instance of the category, start 1.5-100 m)")
 
+
+SEMEXP_MAX_DISTANCE = 100.0  # m: SemExp's max_d for generated Gibson episodes
 
 # Gibson ObjectNav v1.1 uses only these six goal categories (data README).
 GIBSON_GOAL_CATEGORIES: tuple[str, ...] = ("chair", "sofa", "plant", "bed", "toilet", "tv")
@@ -83,7 +87,9 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
     ``GIBSON_GOAL_CATEGORIES`` for Gibson houses, as in Gibson ObjectNav, else
     ``TARGET_CATEGORIES``) that are present and reachable; the start is a uniformly drawn free
     cell whose geodesic distance to the target lies in [min_distance, max_distance], with a
-    uniform yaw. Raises ``DataError`` if the house has no reachable target category.
+    uniform yaw. Raises ``DataError`` if the house has no reachable target category. Under the
+    "semexp" success rule (Gibson) episodes are drawn as SemExp's generator draws them: every
+    instance of the category is a goal and ``max_distance`` is at least 100 m.
 
     Goal instances are only those a camera sees: at least ``min_view_pixels`` pixels in a view
     from one of their view points (``viewpoints.viewable_instances``, as Habitat's ObjectNav
@@ -92,8 +98,13 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
     the check (every instance is a goal, as before the check existed).
     """
     house = _resolve(house)
-    allowed = categories or (GIBSON_GOAL_CATEGORIES if house.name.startswith("gibson:")
-                             else TARGET_CATEGORIES)
+    semexp = house.success_rule == "semexp"
+    allowed = categories or (GIBSON_GOAL_CATEGORIES if semexp else TARGET_CATEGORIES)
+    if semexp:
+        # SemExp's generator (objectgoal_env.generate_new_episode): the goal is every cell of the
+        # category, visible or not, and the start lies 1.5-100 m (its min_d, max_d) from the goal
+        min_view_pixels = None
+        max_distance = max(max_distance, SEMEXP_MAX_DISTANCE)
     present = sorted(c for c in house.categories if c in allowed)
     rng = np.random.default_rng(seed)
     fields: dict[str, tuple[GoalDistance, np.ndarray]] = {}
@@ -144,11 +155,19 @@ def load_habitat_episodes(path: str | Path, house: House | str, *,
     """Read a Habitat ObjectNav ``*_episodes.json(.gz)`` file for one (Gibson) house.
 
     Positions are converted with the Gibson mapping (world = (z_h, x_h, y_h - floor_height),
-    see ``gibson.py``). Episodes of other scenes (``scene_id`` basename) or other floors
-    (``floor_id``) are skipped. A start outside the map, a missing field or an unknown
-    category raises ``DataError`` naming the file and field.
+    see ``gibson.py``). Episodes of other scenes (``scene_id`` basename) or of other floors are
+    skipped; an episode's floor is the one whose ``floor_height`` lies within 0.5 m of its
+    start's height (SemExp's floor rule; ``floor_id`` only for houses without one). A start
+    outside the map or off the traversable area, a goal category with no reachable instance, a
+    missing field or an unknown category raises ``DataError`` naming the file and field.
     """
-    from hiconav.sim.gibson import HABITAT_GOAL_NAMES, HABITAT_TO_CATEGORY, habitat_to_world, habitat_yaw
+    from hiconav.sim.gibson import (
+        FLOOR_TOLERANCE,
+        HABITAT_GOAL_NAMES,
+        HABITAT_TO_CATEGORY,
+        habitat_to_world,
+        habitat_yaw,
+    )
 
     house = _resolve(house)
     path = Path(path)
@@ -164,8 +183,10 @@ def load_habitat_episodes(path: str | Path, house: House | str, *,
     if not isinstance(data, dict) or not isinstance(data.get("episodes"), list):
         raise DataError("expected an object with an 'episodes' list", file=str(path),
                         field="episodes")
-    scene = house.name.split(":", 1)[-1].split("/")[0]
-    floor = int(house.name.split("/")[1]) if "/" in house.name.split(":", 1)[-1] else 0
+    # "gibson:Scene/floor" or "<maps file>#Scene/floor"
+    tail = house.name.rpartition("#")[2] if "#" in house.name else house.name.split(":", 1)[-1]
+    scene, _, floor_text = tail.partition("/")
+    floor = int(floor_text) if floor_text.isdigit() else 0
     out: list[Episode] = []
     nav = house.nav
     for i, ep in enumerate(data["episodes"]):
@@ -175,9 +196,13 @@ def load_habitat_episodes(path: str | Path, house: House | str, *,
             ep_scene = Path(scene_id).name.split(".")[0]
             if ep_scene != scene:
                 continue
-            if "floor_id" in ep and ep["floor_id"] is not None and int(ep["floor_id"]) != floor:
-                continue
             pos = np.asarray(ep["start_position"], dtype=np.float64)
+            if pos.shape == (3,) and house.centre_free is not None:
+                # the floor is the one whose height matches the start's (SemExp's floor_thr)
+                if abs(float(pos[1]) - house.floor_height) > FLOOR_TOLERANCE:
+                    continue
+            elif "floor_id" in ep and ep["floor_id"] is not None and int(ep["floor_id"]) != floor:
+                continue
             quat = np.asarray(ep["start_rotation"], dtype=np.float64)
         except (KeyError, TypeError, ValueError) as exc:
             raise DataError(f"missing or invalid field {exc}", file=str(path),
@@ -207,9 +232,16 @@ def load_habitat_episodes(path: str | Path, house: House | str, *,
             raise DataError(f"{house.name} has no '{category}' instance", file=str(path),
                             field=f"{where}.object_category")
         gd = GoalDistance(house, instance_ids=ids, radius=radius)
+        distance = gd.distance(world[:2])
+        if not math.isfinite(distance):
+            free = distance_mask(house, radius)
+            reason = (f"start {pos.tolist()} (cell {rc.tolist()}) is not on the traversable area of {house.name}"
+                      if not free[rc[0], rc[1]] else
+                      f"no '{category}' of {house.name} is reachable from the start {pos.tolist()}")
+            raise DataError(reason, file=str(path), field=f"{where}.start_position")
         out.append(Episode(
             episode_id=str(ep.get("episode_id", i)), house=house.name,
             start=Pose2D(float(world[0]), float(world[1]), habitat_yaw(quat)), target=category,
-            goal_instance_ids=ids, geodesic_distance=gd.distance(world[:2]),
+            goal_instance_ids=ids, geodesic_distance=distance,
             instruction=instruction_for(category)))
     return out

@@ -1,23 +1,43 @@
-"""Geodesic distances on the navigable grid (Dijkstra with scipy.sparse.csgraph).
+"""Geodesic distances on the navigable grid: where the robot's centre may stand, the distance to a
+goal, the success region and the distance to it, per data set.
 
-The robot's centre may occupy a cell when the cell's clearance (distance from its centre to the
-nearest non-navigable cell, minus half a cell) is at least the robot radius: that is the
-*traversable* mask. Paths move between 8-connected traversable cells (step 1 or sqrt(2) cells)
-and never cut a corner (a diagonal step needs both orthogonal neighbours traversable).
+Where the centre may stand (``centre_free``): for ProcTHOR the navigable grid is the floor free of
+walls and objects, and the centre may occupy a cell when the cell's clearance (distance from its
+centre to the nearest non-navigable cell, minus half a cell) is at least the robot radius. For
+Gibson the data set gives the centre's free space itself: channel 0 of the SemExp maps is
+Habitat's navmesh projected to the floor, already shrunk by Habitat's agent radius, so it is used
+as it is (shrinking it by the radius again closed doorways and corridors: 2 of Habitat's 25
+reference paths stayed traversable).
 
-The distance to a goal object is one multi-source Dijkstra run: every traversable cell within
-``VIEW_RADIUS`` (1.0 m, Euclidean) of the object's footprint that sees the object is a *view
-point* (as Habitat's ObjectNav goal view points, which are kept only where the object is
-visible) and a source whose initial value is its Euclidean distance to the nearest footprint
-cell. *Sees* means a straight line from the cell to one of the footprint cells crosses no
-``House.sight_walls`` cell: without it, a robot shut in the next room counted as having found
-an object on the other side of the wall. If no traversable cell is that close the reach grows
-by 1.5x up to 3 m (a labelled fallback for objects in cluttered corners of the scanned Gibson
-maps, whose navigable channel keeps a gap around furniture); the offsets of such far view
-points are scaled by ``VIEW_RADIUS / reach``, so that the nearest of them lie within the
-success distance (unscaled, an episode on such an object could never succeed). So
-``GoalDistance.distance(xy)`` is the geodesic distance from the robot centre to the nearest goal
-footprint. This module computes distances only; it must not move the robot or render.
+Distances to the success region (SPL's shortest path, DTS) are any-angle: fast marching
+(``hiconav.sim.fmm``), as SemExp and L3MVN measure them; an 8-connected cell path is up to 8%
+longer than Habitat's navmesh path.
+
+Two success rules (``House.success_rule``):
+
+* ``"semexp"`` (the Gibson maps, SemExp's ``objectgoal_env``): the traversable map is the
+  centre's free space dilated by a 2-cell disk; the success region is the goal category's cells
+  dilated by the success distance (a disk of ``round(d / res)`` cells); an episode succeeds when
+  the robot stops in that region (its fast-marching distance to it is 0). No line of sight.
+  ``GoalDistance.field`` is the Euclidean distance to the goal cells inside the region and
+  ``VIEW_RADIUS`` + the fast-marching distance to the region outside it, so ``field <= 1.0``
+  exactly on the region.
+* ``"view_points"`` (ProcTHOR, whose houses have walls and furniture we can see past or not):
+  the distance to a goal object is one multi-source Dijkstra run: every traversable cell within
+  ``VIEW_RADIUS`` (1.0 m, Euclidean) of the object's footprint that sees the object is a *view
+  point* (as Habitat's ObjectNav goal view points, which are kept only where the object is
+  visible) and a source whose initial value is its Euclidean distance to the nearest footprint
+  cell. *Sees* means a straight line from the cell to one of the footprint cells crosses no
+  ``House.sight_walls`` cell: without it, a robot shut in the next room counted as having found
+  an object on the other side of the wall. If no traversable cell is that close the reach grows
+  by 1.5x up to 3 m (a labelled fallback for objects in cluttered corners); the offsets of such
+  far view points are scaled by ``VIEW_RADIUS / reach``, so that the nearest of them lie within
+  the success distance. The success region is the cells whose field is at most the success
+  distance; the distance to it is again fast marching.
+
+Paths on the cell graph (``GridGraph``: 8-connected, no corner cutting) remain for the view-point
+field and for the walk-through tools. This module computes distances only; it must not move the
+robot or render.
 """
 
 from __future__ import annotations
@@ -32,6 +52,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from hiconav.errors import DataError
+from hiconav.sim.fmm import fmm_distance
 from hiconav.sim.house import House, NavGrid
 
 if TYPE_CHECKING:
@@ -39,6 +60,7 @@ if TYPE_CHECKING:
 
 SQRT2 = math.sqrt(2.0)
 VIEW_RADIUS = 1.0  # m: traversable cells this close to a goal footprint are its view points
+SEMEXP_DILATION_CELLS = 2  # SemExp's planner map: the navmesh dilated by skimage disk(2)
 _SOURCE_EPS = 1e-9  # m: keeps zero-offset source edges in the sparse graph; removed from results
 
 
@@ -113,12 +135,43 @@ class GridGraph:
         return out
 
 
+def centre_free(house: House, radius: float) -> np.ndarray:
+    """(H, W) bool cells where the robot's centre may stand: the data set's own mask where it
+    gives one (``House.centre_free``, Gibson), else the cells with clearance >= ``radius``."""
+    if house.centre_free is not None:
+        return np.asarray(house.centre_free, dtype=bool)
+    key = ("centre_free", round(radius, 6))
+    mask = house._cache.get(key)
+    if mask is None:
+        mask = traversable(house.nav, radius)
+        mask.flags.writeable = False
+        house._cache[key] = mask
+    return mask
+
+
+def distance_mask(house: House, radius: float) -> np.ndarray:
+    """(H, W) bool cells that distances are measured through: the centre's free space, dilated by
+    SemExp's 2-cell disk under the "semexp" rule (its ground-truth planner's traversable map)."""
+    free = centre_free(house, radius)
+    if house.success_rule != "semexp":
+        return free
+    key = ("distance_mask", round(radius, 6))
+    mask = house._cache.get(key)
+    if mask is None:
+        from hiconav.sim.fmm import disk
+
+        mask = ndimage.binary_dilation(free, structure=disk(SEMEXP_DILATION_CELLS))
+        mask.flags.writeable = False
+        house._cache[key] = mask
+    return mask
+
+
 def house_graph(house: House, radius: float) -> GridGraph:
-    """The traversable-cell graph of a house for a robot radius (cached on the house)."""
+    """The graph of the robot-centre cells of a house for a robot radius (cached on the house)."""
     key = ("graph", round(radius, 6))
     graph = house._cache.get(key)
     if graph is None:
-        graph = GridGraph(traversable(house.nav, radius), house.nav.resolution)
+        graph = GridGraph(centre_free(house, radius), house.nav.resolution)
         house._cache[key] = graph
     return graph
 
@@ -217,14 +270,41 @@ class GoalDistance:
         key = ("goal", ids, round(self.radius, 6))
         cached = house._cache.get(key)
         if cached is None:
-            graph = house_graph(house, self.radius)
-            foot = np.concatenate([house.footprint(i) for i in ids])
-            cells, offsets = goal_sources(graph, foot, house.nav.resolution, self.radius,
-                                          house.sight_walls)
-            cached = graph.multi_source(cells, offsets)
+            if house.success_rule == "semexp":
+                edt = self._goal_edt()
+                region = edt <= round(VIEW_RADIUS / house.nav.resolution)
+                cached = fmm_distance(distance_mask(house, self.radius), region, house.nav.resolution)
+                cached = np.where(region, edt * house.nav.resolution, cached + VIEW_RADIUS)
+            else:
+                graph = house_graph(house, self.radius)
+                foot = np.concatenate([house.footprint(i) for i in ids])
+                cells, offsets = goal_sources(graph, foot, house.nav.resolution, self.radius,
+                                              house.sight_walls)
+                cached = graph.multi_source(cells, offsets)
             cached.flags.writeable = False
             house._cache[key] = cached
         self.field: np.ndarray = cached
+
+    def _goal_edt(self) -> np.ndarray:
+        """(H, W) float64 Euclidean distance in cells from each cell centre to the nearest goal
+        footprint cell (cached)."""
+        key = ("goal_edt", self.instance_ids)
+        edt = self.house._cache.get(key)
+        if edt is None:
+            foot = np.zeros(self.house.nav.shape, dtype=bool)
+            cells = np.concatenate([self.house.footprint(i) for i in self.instance_ids])
+            if len(cells):
+                foot[cells[:, 0], cells[:, 1]] = True
+            edt = ndimage.distance_transform_edt(~foot) if foot.any() else np.full(foot.shape, np.inf)
+            edt.flags.writeable = False
+            self.house._cache[key] = edt
+        return edt
+
+    def success_region(self, success_distance: float) -> np.ndarray:
+        """(H, W) bool: the cells where a stop succeeds (see the module's two rules)."""
+        if self.house.success_rule == "semexp":
+            return self._goal_edt() <= round(float(success_distance) / self.house.nav.resolution)
+        return self.field <= float(success_distance)
 
     def distance(self, xy: np.ndarray) -> float:
         """Geodesic metres from world ``xy`` (2,) to the nearest goal footprint (inf if none).
@@ -236,13 +316,12 @@ class GoalDistance:
 
     def success_field(self, success_distance: float) -> np.ndarray:
         """(H, W) geodesic metres from each cell to the nearest cell of the success region (the
-        cells whose ``field`` is at most ``success_distance``; 0 inside it, inf if unreachable)."""
+        ``success_region``; 0 inside it, inf if unreachable), by fast marching."""
         key = ("success", self.instance_ids, round(self.radius, 6), round(float(success_distance), 9))
         cached = self.house._cache.get(key)
         if cached is None:
-            region = np.argwhere(self.field <= float(success_distance))
-            graph = house_graph(self.house, self.radius)
-            cached = graph.multi_source(region, np.zeros(len(region)))
+            cached = fmm_distance(distance_mask(self.house, self.radius),
+                                  self.success_region(success_distance), self.house.nav.resolution)
             cached.flags.writeable = False
             self.house._cache[key] = cached
         return cached
@@ -302,7 +381,11 @@ class GoalDistance:
 
 
 def point_distance_field(house: House, xy: np.ndarray, radius: float = 0.18) -> np.ndarray:
-    """(H, W) geodesic metres from a world point ``xy`` (its cell must be traversable)."""
-    graph = house_graph(house, radius)
+    """(H, W) any-angle geodesic metres (fast marching through ``distance_mask``) from a world
+    point ``xy``; inf everywhere when its cell is not traversable."""
+    mask = distance_mask(house, radius)
     rc = house.nav.world_to_cell(np.asarray(xy)[:2])
-    return graph.multi_source(rc[None, :], np.zeros(1))
+    src = np.zeros(mask.shape, dtype=bool)
+    if house.nav.in_bounds(rc) and mask[rc[0], rc[1]]:
+        src[rc[0], rc[1]] = True
+    return fmm_distance(mask, src, house.nav.resolution)

@@ -39,6 +39,10 @@ from hiconav.sim.procthor import category_color
 
 RESOLUTION = 0.05
 WALL_HEIGHT = 2.6  # m
+# Habitat's agent radius in the Gibson ObjectNav task (SemExp's objectnav_gibson.yaml): the
+# navmesh of channel 0 keeps the agent's centre this far from every obstacle.
+HABITAT_AGENT_RADIUS = 0.18  # m
+FLOOR_TOLERANCE = 0.5  # m: a start this close to a floor's floor_height is on it (SemExp floor_thr)
 
 # Channel k (1-based) of sem_map -> category (Habitat names mapped to ours).
 CHANNEL_CATEGORIES = ("chair", "sofa", "plant", "bed", "toilet", "tv", "dining_table", "oven",
@@ -121,8 +125,9 @@ def habitat_yaw(quat_xyzw: np.ndarray) -> float:
     return math.atan2(r[0], r[2])
 
 
-def floor_record(data_dir: Path, scene: str, floor: int) -> dict[str, Any]:
-    path = info_path(data_dir)
+def floor_record(data_dir: Path | str, scene: str, floor: int) -> dict[str, Any]:
+    """The record of one floor; ``data_dir`` is the data root or the maps file itself."""
+    path = str(data_dir) if str(data_dir).endswith(".pbz2") else info_path(Path(data_dir))
     info = load_info(path)
     if scene not in info:
         raise DataError(f"unknown Gibson scene '{scene}'; valid: {', '.join(sorted(info))}",
@@ -166,9 +171,58 @@ def clean_floor(floor: np.ndarray, objects: np.ndarray) -> np.ndarray:
     return (closed | small[labels]) & ~objects
 
 
+def floor_for_height(maps_file: Path | str, scene: str, height: float) -> int | None:
+    """The floor of ``scene`` whose ``floor_height`` is nearest the Habitat height ``height`` (m),
+    within ``FLOOR_TOLERANCE`` (SemExp's ``floor_thr``, 0.5 m); None when no floor is that close
+    (the position lies on a floor the maps file does not hold)."""
+    floors = load_info(str(maps_file)).get(scene) or {}
+    best, gap = None, FLOOR_TOLERANCE
+    for index in sorted(floors):
+        rec = floors[index]
+        if not isinstance(rec, dict):
+            continue
+        d = abs(float(rec.get("floor_height", 0.0)) - float(height))
+        if d <= gap:
+            best, gap = int(index), d
+    return best
+
+
+def floor_heights(maps_file: Path | str, scene: str) -> str:
+    """"0 at 0.00 m, 1 at 3.10 m": the floors of ``scene`` for messages."""
+    floors = load_info(str(maps_file)).get(scene) or {}
+    return ", ".join(f"{k} at {float(v.get('floor_height', 0.0)):.2f} m" for k, v in sorted(floors.items())
+                     if isinstance(v, dict)) or "none"
+
+
+def render_obstacles(nav_mask: np.ndarray, objects: np.ndarray, radius: float = HABITAT_AGENT_RADIUS,
+                     res: float = RESOLUTION) -> np.ndarray:
+    """(H, W) bool cells where walls and unlabelled furniture are drawn.
+
+    Habitat's navmesh (channel 0) stops ``radius`` short of every wall and piece of furniture, so
+    the obstacles stand about that far beyond its edge: a cell is drawn when its centre lies
+    farther than ``radius`` plus half a cell from the nearest navmesh cell's centre (the navmesh's
+    edge runs through its edge cells), so that a map of what the robot sees, inflated by the
+    robot's radius, leaves the navmesh free. A band of non-navigable cells too thin to hold such a cell (a
+    thin inner wall, a doorway's jamb) keeps its ridge cells (those no nearer the navmesh than any
+    neighbour), so that no wall between two rooms disappears from view.
+    """
+    blocked = ~nav_mask & ~objects
+    dist = ndimage.distance_transform_edt(~nav_mask) * res
+    ridge = dist >= ndimage.maximum_filter(dist, size=3) - 1e-9
+    return blocked & ((dist > radius + res / 2.0 + 1e-9) | ridge)
+
+
 def load_gibson(scene: str, floor: int, data_dir: Path) -> House:
-    """Build the ``House`` of one Gibson floor."""
-    rec = floor_record(data_dir, scene, floor)
+    """Build the ``House`` of one Gibson floor of the data root's maps file."""
+    return load_gibson_file(Path(info_path(data_dir)), scene, floor,
+                            name=f"gibson:{scene}" if floor == 0 else f"gibson:{scene}/{floor}")
+
+
+def load_gibson_file(path: Path | str, scene: str, floor: int, *, name: str | None = None) -> House:
+    """Build the ``House`` of one floor of any SemExp / L3MVN maps file (``*_info.pbz2``), named
+    ``<path>#<scene>/<floor>`` unless ``name`` is given."""
+    path = Path(path)
+    rec = floor_record(str(path), scene, floor)
     sem = np.asarray(rec["sem_map"]) > 0
     origin = np.asarray(rec["origin"], dtype=np.float64) / 100.0  # (x_w, y_w) = (z_h, x_h)
     floor_height = float(rec.get("floor_height", 0.0))
@@ -206,17 +260,25 @@ def load_gibson(scene: str, floor: int, data_dir: Path) -> House:
             quads.append(mask_side_quads(window, win_origin, RESOLUTION, z0, z1, color, iid,
                                          "object", top=True))
     # Walls / clutter: every other cell, drawn as the vertical faces that border the floor
-    # or an object (the only faces visible from the floor; the ceiling covers their tops).
+    # or an object (the only faces visible from the floor; the ceiling covers their tops), one
+    # agent radius beyond the navmesh's edge (``render_obstacles``).
     nav_mask = clean_floor(nav_mask, any_object)
     walls, furniture = split_clutter(~(nav_mask | any_object))
+    drawn = render_obstacles(nav_mask, any_object)
+    walls &= drawn
+    furniture &= drawn
     quads.append(mask_side_quads(walls, origin, RESOLUTION, 0.0, WALL_HEIGHT,
                                  (0.8, 0.78, 0.74), material="wall"))
     quads.append(mask_side_quads(furniture, origin, RESOLUTION, 0.0, CLUTTER_HEIGHT,
                                  (0.55, 0.45, 0.35), material="wall", top=True))
-    nav = NavGrid(clean_floor(nav_mask, any_object), origin, RESOLUTION)
-    name = f"gibson:{scene}" if floor == 0 else f"gibson:{scene}/{floor}"
-    return House(name=name, objects=objects, nav=nav, rooms=[], boxes=[],
-                 quads=QuadSet.concat(quads),
+    # The navigable grid is the floor free of drawn obstacles and objects; the robot's centre
+    # may stand on the navmesh alone (``House.centre_free``), as in Habitat.
+    nav = NavGrid(~(walls | furniture | any_object), origin, RESOLUTION)
+    centre = nav_mask.copy()
+    centre.flags.writeable = False
+    return House(name=name or f"{path.resolve()}#{scene}/{floor}", objects=objects, nav=nav, rooms=[],
+                 boxes=[], quads=QuadSet.concat(quads),
                  footprints=footprints, wall_height=WALL_HEIGHT,
-                 floor_color=(0.5, 0.47, 0.42), source=info_path(data_dir),
-                 floor_height=floor_height, sight_walls=walls)
+                 floor_color=(0.5, 0.47, 0.42), source=str(path),
+                 floor_height=floor_height, sight_walls=walls, centre_free=centre,
+                 success_rule="semexp")

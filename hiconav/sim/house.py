@@ -185,6 +185,14 @@ class House:
     wall_height: ceiling height (m); sight_walls: (H, W) bool cells of the walls that stand at
     the camera's height (``SIGHT_HEIGHT``): a goal view point must see its object past them
     (None: nothing blocks the view).
+
+    Where the robot's centre may stand differs by data set (``hiconav.sim.geodesic.centre_free``):
+    ``centre_free`` None means the navigable grid is the floor free of walls and objects and the
+    centre keeps the robot's radius from every blocked cell (ProcTHOR); a mask means the data set
+    gives the centre's free space itself (Gibson's channel 0 is Habitat's navmesh, already shrunk
+    by Habitat's agent radius). ``success_rule``: "view_points" (success within 1 m geodesic of a
+    goal via a view point that sees it) or "semexp" (SemExp's protocol for the Gibson maps: the
+    goal category's cells dilated by the success distance; see ``geodesic.GoalDistance``).
     """
 
     name: str
@@ -201,6 +209,8 @@ class House:
     start_hint: tuple[float, float, float] | None = None  # (x, y, yaw) from the data set
     floor_height: float = 0.0  # source-frame height of this floor (Gibson episodes)
     sight_walls: np.ndarray | None = None
+    centre_free: np.ndarray | None = None  # (H, W) bool robot-centre cells given by the data set
+    success_rule: str = "view_points"
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property

@@ -1,5 +1,8 @@
 """``load_house(spec)``: address a house by name ("procthor:val/3", "gibson:Allensville",
-"gibson:Allensville/0") or by a file path (a ProcTHOR house ``.json``/``.json.gz``).
+"gibson:Allensville/0"), by a file path (a ProcTHOR house ``.json``/``.json.gz``), or by a house
+of a data file anywhere on disk: ``FILE.jsonl.gz#N`` (line N, 0-based, of a ProcTHOR houses file)
+or ``FILE.pbz2#Scene/floor`` (a floor of a SemExp / L3MVN Gibson maps file such as
+``val_info.pbz2``).
 
 Loaded houses are cached per spec (they are treated as immutable). This module resolves names
 and dispatches to the loaders; it must not contain data-set parsing itself.
@@ -55,6 +58,8 @@ def load_house(spec: str, data_dir: Path | None = None, *, cache: bool = True) -
             raise DataError(f"bad Gibson house name '{spec}': expected gibson:Scene or "
                             "gibson:Scene/floor", field="house")
         house = gibson.load_gibson(scene, int(floor) if slash else 0, root)
+    elif "#" in spec and Path(spec.rpartition("#")[0]).expanduser().is_file():
+        house = _load_file_entry(spec, root)
     else:
         path = Path(spec)
         if path.is_file():
@@ -63,7 +68,24 @@ def load_house(spec: str, data_dir: Path | None = None, *, cache: bool = True) -
             scenes = ", ".join(gibson.scene_names(root)) if (root / "gibson").is_dir() else ""
             raise DataError(
                 f"unknown house '{spec}': not a file, and not one of procthor:train/0..99, "
-                f"procthor:val/0..99, gibson:<scene> with scene in: {scenes}", field="house")
+                f"procthor:val/0..99, gibson:<scene> with scene in: {scenes}, FILE.jsonl.gz#N or "
+                "FILE.pbz2#Scene/floor", field="house")
     if cache:
         _CACHE[key] = house
     return house
+
+
+def _load_file_entry(spec: str, root: Path) -> House:
+    """``FILE#N`` (ProcTHOR houses file) or ``FILE#Scene/floor`` (Gibson maps file)."""
+    from hiconav.sim import gibson, procthor
+
+    file, _, entry = spec.rpartition("#")
+    path = Path(file).expanduser().resolve()
+    if path.name.endswith(".pbz2"):
+        scene, slash, floor = entry.partition("/")
+        if not scene or (slash and not floor.isdigit()):
+            raise DataError(f"bad Gibson house '{spec}': expected FILE.pbz2#Scene/floor", field="house")
+        return gibson.load_gibson_file(path, scene, int(floor) if slash else 0)
+    if not entry.isdigit():
+        raise DataError(f"bad house '{spec}': expected FILE.jsonl.gz#N (N the 0-based line)", field="house")
+    return procthor.load_procthor_line(path, int(entry), root)

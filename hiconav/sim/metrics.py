@@ -8,7 +8,8 @@ measures it to the goal's view points (Anderson et al. 2018; Batra et al. 2020).
 the goal object itself, l exceeds the shortest successful path by up to the success distance:
 an agent that stopped on the region's edge after 0.97 m scored SPL 1 against an "l" of 1.57 m
 (Gibson Stockman/0/1), and SPL over-stated efficiency most on the shortest episodes. DTS: the
-geodesic distance to the success region at the end, max(0, d_T - success_distance). This module
+geodesic distance to the success region at the end. Distances to the region are any-angle
+(fast marching, ``geodesic``). This module
 scores episodes; it must not move the robot.
 """
 
@@ -59,18 +60,21 @@ class EpisodeMetrics:
 
 def episode_metrics(episode: Episode, *, final_distance: float, path_length: float,
                     steps: int, stopped: bool, shortest_to_success: float, collisions: int = 0,
-                    config: SimConfig | None = None) -> EpisodeMetrics:
+                    config: SimConfig | None = None,
+                    final_to_success: float | None = None) -> EpisodeMetrics:
     """Score an episode from its end state (hand-made cases in tests use this directly).
 
     ``shortest_to_success``: the geodesic distance from the start to the success region (SPL's l;
-    ``GoalDistance.to_success``)."""
+    ``GoalDistance.to_success``); ``final_to_success``: the same from where the robot ended (the
+    DTS; when None, ``final_distance - success_distance``, a lower bound of it)."""
     cfg = config or SimConfig()
     success = bool(stopped and steps <= cfg.max_steps and
                    final_distance <= cfg.success_distance)
     return EpisodeMetrics(
         episode_id=episode.episode_id, house=episode.house, target=episode.target,
         success=success, spl=spl(success, shortest_to_success, path_length),
-        dts=dts(final_distance, cfg.success_distance), final_distance=float(final_distance),
+        dts=dts(final_distance, cfg.success_distance) if final_to_success is None
+        else max(0.0, float(final_to_success)), final_distance=float(final_distance),
         shortest=float(episode.geodesic_distance), path_length=float(path_length),
         steps=int(steps), collisions=int(collisions), stopped=bool(stopped),
         shortest_to_success=float(shortest_to_success))
@@ -94,4 +98,5 @@ class EpisodeTracker:
         return episode_metrics(self.episode, final_distance=self.goal.distance(sim.pose.xy),
                                path_length=sim.path_length, steps=sim.steps,
                                stopped=sim.stopped, collisions=sim.collisions,
-                               shortest_to_success=self.shortest_to_success, config=sim.config)
+                               shortest_to_success=self.shortest_to_success, config=sim.config,
+                               final_to_success=self.goal.to_success(sim.pose.xy, sim.config.success_distance))

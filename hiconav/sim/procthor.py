@@ -328,12 +328,18 @@ def load_procthor(split: str, index: int, data_dir: Path) -> House:
     if not path.is_file():
         raise DataError(f"ProcTHOR split '{split}' not found (expected train or val)",
                         file=str(path))
+    return load_procthor_line(path, index, data_dir, name=f"procthor:{split}/{index}")
+
+
+def load_procthor_line(path: Path, index: int, data_dir: Path, *, name: str | None = None) -> House:
+    """House ``index`` (0-based, counting non-empty lines) of any ProcTHOR ``*.jsonl(.gz)`` file,
+    named ``<path>#<index>`` unless ``name`` is given."""
     lines = split_lines(str(path))
     if not 0 <= index < len(lines):
-        raise DataError(f"house index {index} out of range: procthor:{split} has houses "
-                        f"0..{len(lines) - 1}", file=str(path))
+        raise DataError(f"house index {index} out of range: {path} has houses 0..{len(lines) - 1}",
+                        file=str(path), field="house")
     data = parse_json(lines[index], str(path), index + 1)
-    return build_house(data, f"procthor:{split}/{index}", str(path), index + 1,
+    return build_house(data, name or f"{path}#{index}", str(path), index + 1,
                        str(data_dir / "procthor" / "asset-database.json"))
 
 

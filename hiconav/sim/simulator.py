@@ -1,9 +1,10 @@
 """The agent in a house: Habitat-style discrete actions and continuous (v, omega, dt) motion
 with collisions against the navigable grid, and RGB-D + instance observations.
 
-Collision model: the robot is a disc of ``robot_radius``; its centre may only be where the
-cell's clearance (``geodesic.clearance``) is at least the radius, so the disc never overlaps a
-wall or object cell. Motion is integrated in sub-steps of at most half a cell; a sub-step that
+Collision model: the robot is a disc of ``robot_radius``; its centre may only be on the cells of
+``geodesic.centre_free``: where the cell's clearance is at least the radius, so the disc never
+overlaps a wall or object cell (ProcTHOR), or on the data set's own centre space (Gibson's
+channel 0, Habitat's navmesh). Motion is integrated in sub-steps of at most half a cell; a sub-step that
 would leave free space sets ``collided`` for that step and, with ``allow_sliding`` (Habitat-
 Sim's default), slides: the robot takes the sub-step's x or y component alone (the longer one
 first) when that stays free, so it glides along a wall met at an angle instead of stopping dead;
@@ -20,7 +21,7 @@ import numpy as np
 
 from hiconav.errors import HiconavError
 from hiconav.sim.config import SimConfig
-from hiconav.sim.geodesic import clearance
+from hiconav.sim.geodesic import centre_free, clearance
 from hiconav.sim.house import House
 from hiconav.types import (
     CameraIntrinsics,
@@ -50,7 +51,7 @@ class Simulator:
         c = self.config
         self.intrinsics = CameraIntrinsics.from_hfov(c.width, c.height, c.hfov_deg)
         self.clearance = clearance(house.nav)
-        self.free = self.clearance >= c.robot_radius - 1e-9  # (H, W) robot-centre cells
+        self.free = centre_free(house, c.robot_radius)  # (H, W) robot-centre cells
         self._renderer = None
         self.pose = Pose2D(0.0, 0.0, 0.0)
         self.tilt = 0.0  # rad, positive looking up

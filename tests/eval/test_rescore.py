@@ -25,7 +25,8 @@ def test_a_run_scored_against_the_object_distance_is_rescored_to_the_success_reg
     (tmp_path / "episodes.jsonl").write_text("".join(dumps(r) + "\n" for r in records))
     goal = GoalDistance(specs[0].load_house(), instance_ids=list(specs[0].goal_instance_ids))
     l_s = goal.to_success(np.asarray(specs[0].start[:2]), 1.0)
-    assert l_obj - 1.0 - 1e-6 <= l_s < l_obj  # shorter, by the success distance at most
+    # shorter, by the success distance at most (and by up to 8% more: l_s is any-angle, l_obj cell paths)
+    assert 0.92 * (l_obj - 1.0) <= l_s < l_obj
     n, sr, old, new = rescore(tmp_path)["full"]
     assert (n, sr, old) == (2, 0.5, 0.5)
     assert new == pytest.approx(0.5 * l_s / l_obj)

@@ -11,7 +11,7 @@ import pytest
 
 from hiconav.errors import DataError
 from hiconav.sim.episodes import TARGET_CATEGORIES, generate_episodes, load_habitat_episodes
-from hiconav.sim.geodesic import GoalDistance, traversable
+from hiconav.sim.geodesic import GoalDistance, centre_free
 from hiconav.sim.houses import load_house
 from hiconav.sim.simulator import Simulator
 from hiconav.sim.viewpoints import viewable_instances
@@ -30,13 +30,15 @@ def test_generation_is_deterministic_per_seed(shared_data, spec):
 @pytest.mark.parametrize("spec", ["procthor:val/3", "gibson:Cosmos"])
 def test_episodes_are_valid(shared_data, spec):
     house = load_house(spec, shared_data)
-    free = traversable(house.nav, 0.18)
+    free = centre_free(house, 0.18)
     sim = Simulator(house)
     for ep in generate_episodes(house, 10, seed=0):
         assert ep.target in TARGET_CATEGORIES and ep.target in house.categories
-        # the goals are the instances of the category that a camera sees from a view point
         every = tuple(o.instance_id for o in house.instances_of(ep.target))
-        assert ep.goal_instance_ids == viewable_instances(house, every, sim)
+        if house.success_rule == "semexp":  # SemExp's generator: every instance of the category
+            assert ep.goal_instance_ids == every
+        else:  # the goals are the instances of the category that a camera sees from a view point
+            assert ep.goal_instance_ids == viewable_instances(house, every, sim)
         rc = house.nav.world_to_cell(ep.start.xy)
         assert free[rc[0], rc[1]]
         d = GoalDistance(house, ep).distance(ep.start.xy)
