@@ -184,7 +184,8 @@ def _convert(exc: yaml.YAMLError, text: str, source: str, error: type[ConfigErro
     if isinstance(exc, yaml.reader.ReaderError):
         line, column = _position(text, exc.position) if isinstance(exc.position, int) else (None, None)
         char = exc.character if isinstance(exc.character, str) else chr(exc.character)
-        what = "a NUL byte" if char == "\0" else f"the control character {char!r} (#x{ord(char):04x})"
+        kind = "control" if ord(char) < 0x20 or 0x7F <= ord(char) <= 0x9F else "non-printable"
+        what = "a NUL byte" if char == "\0" else f"the {kind} character {char!r} (#x{ord(char):04x})"
         return error(f"{what} at column {column}: YAML text may hold only printable characters "
                      "(is this a binary file?)", file=source, line=line, field=field)
     if isinstance(exc, yaml.MarkedYAMLError):

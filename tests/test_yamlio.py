@@ -57,6 +57,12 @@ def test_a_control_character_is_refused_with_its_line(tmp_path: Path) -> None:
     assert f"{path}:3" in str(info.value)
 
 
+def test_a_non_character_is_refused_as_non_printable() -> None:
+    with pytest.raises(ConfigError, match=r"non-printable character '\\ufffe'") as info:
+        load_text("a: \ufffe\n", source="odd.yaml")
+    assert info.value.line == 1
+
+
 def test_a_byte_order_mark_is_accepted(tmp_path: Path) -> None:
     path = write(tmp_path, "\ufeffa: 1\n")
     assert load_file(path)[0] == {"a": 1}
