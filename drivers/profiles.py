@@ -19,7 +19,9 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from hiconav import yamlio
 from hiconav.errors import ConfigError
+from hiconav.limits import MAX_DURATION_S
 from hiconav.types import CameraIntrinsics, Pose2D, camera_pose_from_base
 
 __all__ = [
@@ -36,7 +38,7 @@ __all__ = [
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class CameraExtrinsics(_Model):
@@ -114,11 +116,11 @@ class DiscreteProfile(_Model):
 class FailsafeProfile(_Model):
     """Timeouts (s). A latched failsafe (link, heartbeat, geofence, mode) pauses until resume()."""
 
-    link_timeout_s: float = Field(0.5, gt=0.0, description="no message from the vehicle -> stop, pause")
-    heartbeat_timeout_s: float = Field(3.0, gt=0.0, description="no HEARTBEAT -> stop, pause")
-    pose_timeout_s: float = Field(0.5, gt=0.0, description="pose older than this -> stop")
-    command_timeout_s: float = Field(0.5, gt=0.0, description="no command from the navigator -> zero")
-    geofence_lookahead_s: float = Field(1.0, ge=0.0, description="refuse motion that leaves the fence")
+    link_timeout_s: float = Field(0.5, gt=0.0, le=MAX_DURATION_S, description="no message from the vehicle -> stop, pause")
+    heartbeat_timeout_s: float = Field(3.0, gt=0.0, le=MAX_DURATION_S, description="no HEARTBEAT -> stop, pause")
+    pose_timeout_s: float = Field(0.5, gt=0.0, le=MAX_DURATION_S, description="pose older than this -> stop")
+    command_timeout_s: float = Field(0.5, gt=0.0, le=MAX_DURATION_S, description="no command from the navigator -> zero")
+    geofence_lookahead_s: float = Field(1.0, ge=0.0, le=MAX_DURATION_S, description="refuse motion that leaves the fence")
     resume_on_link_recovery: bool = False
 
 
@@ -156,8 +158,8 @@ class MavlinkProfile(_Model):
     source_component: int = Field(190, ge=0, le=255)
     target_system: int = Field(0, ge=0, le=255, description="0 = the first vehicle heard")
     target_component: int = Field(1, ge=0, le=255)
-    heartbeat_wait_s: float = Field(10.0, gt=0.0)
-    ack_timeout_s: float = Field(1.5, gt=0.0)
+    heartbeat_wait_s: float = Field(10.0, gt=0.0, le=MAX_DURATION_S)
+    ack_timeout_s: float = Field(1.5, gt=0.0, le=MAX_DURATION_S)
     retries: int = Field(2, ge=0, le=10)
 
     @property
@@ -271,14 +273,7 @@ def load_profile(spec: str | Path) -> RobotProfile:
             raise ConfigError(f"no robot profile {str(spec)!r}: not a file, and not one of {known}",
                               field="profile")
         path = candidate
-    text = path.read_text(encoding="utf-8")
-    try:
-        root = yaml.compose(text)
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise ConfigError(f"not valid YAML: {getattr(exc, 'problem', exc)}", file=str(path),
-                          line=mark.line + 1 if mark else None) from None
+    data, root = yamlio.load_file(path, what="robot profile")
     if data is None:
         raise ConfigError("the robot profile is empty", file=str(path))
     if isinstance(data, dict) and "name" not in data:

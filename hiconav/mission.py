@@ -31,6 +31,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field
 
 from hiconav.errors import ConfigError
+from hiconav.limits import MAX_DURATION_S, MAX_RATE_HZ
 from hiconav.settings import _merge, nest
 from hiconav.types import Pose2D
 
@@ -47,21 +48,21 @@ def typer_option(default: Any, *names: str, help: str = "") -> Any:
 class RatesConfig(BaseModel):
     """Actor rates in Hz (virtual Hz in stepped mode)."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
-    driver: float = Field(10.0, gt=0)
-    perception: float = Field(10.0, gt=0)
-    memory: float = Field(10.0, gt=0)
-    reasoning: float = Field(10.0, gt=0)
-    exploration: float = Field(2.0, gt=0)
-    mission: float = Field(10.0, gt=0)
-    control: float = Field(10.0, gt=0)
+    driver: float = Field(10.0, gt=0, le=MAX_RATE_HZ)
+    perception: float = Field(10.0, gt=0, le=MAX_RATE_HZ)
+    memory: float = Field(10.0, gt=0, le=MAX_RATE_HZ)
+    reasoning: float = Field(10.0, gt=0, le=MAX_RATE_HZ)
+    exploration: float = Field(2.0, gt=0, le=MAX_RATE_HZ)
+    mission: float = Field(10.0, gt=0, le=MAX_RATE_HZ)
+    control: float = Field(10.0, gt=0, le=MAX_RATE_HZ)
 
 
 class MissionConfig(BaseModel):
     """mission.*: the tree, the clock, the rates and the mission's own switches."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     tree: str = "objectnav"
     clock: str = Field("stepped", pattern="^(stepped|real)$")
@@ -76,9 +77,9 @@ class MissionConfig(BaseModel):
     remap_area_m2: float = Field(1.0, ge=0)
     # stepped: a reply becomes visible after this (None: the measured latency of a VLM; the offline
     # reasoner then counts as instantaneous so that same-seed runs stay identical)
-    vlm_latency_s: float | None = Field(None, ge=0)
-    parse_latency_s: float | None = Field(None, ge=0)
-    max_time_s: float = Field(600.0, gt=0)  # clock seconds before the run is cut off
+    vlm_latency_s: float | None = Field(None, ge=0, le=MAX_DURATION_S)
+    parse_latency_s: float | None = Field(None, ge=0, le=MAX_DURATION_S)
+    max_time_s: float = Field(600.0, gt=0, le=MAX_DURATION_S)  # clock seconds before the run is cut off
     prune_every: int = Field(20, ge=0)  # ILP anchor pruning every n integrations (0: never)
     control_mode: str = Field("discrete", pattern="^(discrete|velocity)$")
     # user actors by import path "package.module:NodeClass" -> keyword arguments; each is a

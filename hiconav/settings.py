@@ -17,6 +17,7 @@ from typing import Any, get_args, get_origin
 import yaml
 from pydantic import BaseModel, ValidationError
 
+from hiconav import yamlio
 from hiconav.errors import ConfigError
 
 #: section name -> "module:Model" of the layer that owns it
@@ -135,17 +136,7 @@ def load_settings_file(path: str | Path) -> dict[str, Any]:
     """Read a settings YAML file into dotted overrides, validated against every section's model."""
     path = Path(path)
     source = str(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ConfigError(f"cannot read settings file: {exc.strerror}", file=source) from exc
-    try:
-        node = yaml.compose(text)
-        data = yaml.safe_load(text) if node is not None else {}
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = mark.line + 1 if mark is not None else None
-        raise ConfigError(f"malformed YAML: {getattr(exc, 'problem', exc)}", file=source, line=line) from exc
+    data, node = yamlio.load_file(path, what="settings file")
     if data is None:
         return {}
     if not isinstance(data, dict):
@@ -174,9 +165,10 @@ def parse_set_options(items: list[str]) -> dict[str, Any]:
         if not sep or "." not in key:
             raise ConfigError(f"--set expects area.key=value, got {item!r}", field="--set")
         try:
-            overrides[key] = yaml.safe_load(value)
-        except yaml.YAMLError as exc:
-            raise ConfigError(f"--set {key}: value is not valid YAML: {exc}", field=key) from exc
+            overrides[key] = yamlio.load_text(value, source="--set", field=key)[0]
+        except ConfigError as exc:
+            reason = exc.reason if exc.reason.startswith("not valid YAML") else f"not valid YAML: {exc.reason}"
+            raise ConfigError(f"--set {key}: {reason}", field=key) from None
     return overrides
 
 

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from hiconav import yamlio
 from hiconav.trees.errors import TreeError
 from hiconav.trees.registry import BLACKBOARD_REF, NodeSpec, spec_for
 
@@ -85,13 +86,7 @@ def _err(message: str, file: str, node: yaml.Node | None, key: str | None = None
 
 
 def _scalar(node: yaml.Node, file: str, key: str) -> Any:
-    loader = yaml.SafeLoader("")
-    try:
-        return loader.construct_object(node, deep=True)
-    except yaml.YAMLError as exc:
-        raise _err(f"cannot read value: {exc}", file, node, key) from exc
-    finally:
-        loader.dispose()
+    return yamlio.construct(node, source=file, error=TreeError, field=key)
 
 
 def _mapping_items(node: yaml.Node, file: str, what: str, key: str | None = None) -> list[tuple[str, yaml.Node, yaml.Node]]:
@@ -143,16 +138,7 @@ class _Parser:
 
     def parse_file(self, path: Path, stack: tuple[tuple[str, str], ...] = ()) -> TreeDefinition:
         file = str(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise TreeError(f"cannot read mission tree: {exc}", file=file) from exc
-        try:
-            doc = yaml.compose(text, Loader=yaml.SafeLoader)
-        except yaml.MarkedYAMLError as exc:
-            mark = exc.problem_mark or exc.context_mark
-            line = mark.line + 1 if mark is not None else None
-            raise TreeError(f"YAML syntax error: {exc.problem or exc}", file=file, line=line) from exc
+        doc = yamlio.compose_file(path, error=TreeError, what="mission tree")
         if doc is None:
             raise TreeError("empty mission file: expected a mapping with a 'root' node", file=file, line=1)
         items = _mapping_items(doc, file, "a mission file")

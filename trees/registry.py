@@ -10,6 +10,7 @@ declarations. Users add behaviours with ``@register_behaviour`` or by import pat
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -31,6 +32,7 @@ class Param:
     ``type`` is one of bool, int, float, str, list; ints are accepted where floats are expected.
     ``minimum``/``maximum`` are inclusive bounds for numbers; ``choices`` limits strings.
     ``blackboard``: whether the YAML may give ``{key}`` instead of a literal.
+    ``finite``: a float must be a finite number (``.nan`` and ``.inf`` are refused) unless False.
     """
 
     type: type
@@ -40,6 +42,7 @@ class Param:
     choices: tuple[Any, ...] | None = None
     blackboard: bool = True
     doc: str = ""
+    finite: bool = True
 
     @property
     def required(self) -> bool:
@@ -56,6 +59,8 @@ class Param:
             ok = isinstance(value, expected)
         if not ok:
             return f"expected {expected.__name__}, got {type(value).__name__} {value!r}"
+        if expected is float and self.finite and not math.isfinite(value):
+            return f"{value!r} is not a finite number"
         if self.minimum is not None and value < self.minimum:
             return f"{value!r} is below the minimum {self.minimum}"
         if self.maximum is not None and value > self.maximum:

@@ -12,11 +12,13 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from hiconav.limits import MAX_DURATION_S
+
 
 class UtilityConfig(BaseModel):
     """exploration.utility.*: S(f) = l1 S_struct(f) + l2 S_vis(f) and the weights W (eq. 16)."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     lambda1: float = Field(1.0, ge=0.0, description="weight of S_struct (eq. 9)")
     lambda2: float = Field(1.0, ge=0.0, description="weight of S_vis (eq. 9)")
@@ -41,7 +43,7 @@ class UtilityConfig(BaseModel):
 class CostConfig(BaseModel):
     """exploration.cost.*: the transition costs M (eq. 17-21)."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     v_max: float = Field(0.5, gt=0.0, description="max linear speed (m/s), eq. 17")
     xi_dot_max: float = Field(0.8, gt=0.0, description="max yaw rate (rad/s), eq. 17")
@@ -59,12 +61,12 @@ class CostConfig(BaseModel):
 class OrderingConfig(BaseModel):
     """exploration.ordering.*: the WTRP solve and goal hysteresis."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     ordering: Literal["wtrp", "greedy_utility", "nearest"] = Field(
         "wtrp", description="ablation: WTRP order, highest weight first, or nearest first")
     solver: str = Field("auto", description="WTRP solver: auto | exact | ils | ortools | greedy | module:callable")
-    time_limit: float = Field(0.2, gt=0.0, description="solver time limit (s) per plan")
+    time_limit: float = Field(0.2, gt=0.0, le=MAX_DURATION_S, description="solver time limit (s) per plan")
     stepped_restarts: int = Field(2, ge=1, description="on the stepped clock the ILS has no time limit and "
                                   "runs this many starts instead, so an episode is the same on any machine")
     seed: int = 0
@@ -78,7 +80,7 @@ class OrderingConfig(BaseModel):
 class ExplorationConfig(BaseModel):
     """exploration.*"""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     utility: UtilityConfig = Field(default_factory=UtilityConfig)
     cost: CostConfig = Field(default_factory=CostConfig)

@@ -8,7 +8,7 @@ from pydantic import BaseModel, ConfigDict, Field
 class OccupancyConfig(BaseModel):
     """mapping.occupancy.*: the 2D occupancy grid built from depth."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     resolution: float = Field(0.05, gt=0.0, description="cell side (m)")
     initial_size_m: float = Field(12.0, gt=0.0, description="side of the first grid, centred on the robot")
@@ -65,7 +65,7 @@ class OccupancyConfig(BaseModel):
 class FrontierConfig(BaseModel):
     """mapping.frontiers.*: frontier extraction and tracking."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     min_size_cells: int = Field(8, ge=1, description="smaller frontier clusters are dropped")
     max_size_cells: int = Field(400, ge=1, description="larger clusters are split along their length")
@@ -80,7 +80,7 @@ class FrontierConfig(BaseModel):
 class MappingConfig(BaseModel):
     """mapping.* settings."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     occupancy: OccupancyConfig = Field(default_factory=OccupancyConfig)
     frontiers: FrontierConfig = Field(default_factory=FrontierConfig)

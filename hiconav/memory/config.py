@@ -26,11 +26,13 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from hiconav.limits import MAX_DURATION_S
+
 
 class MemoryConfig(BaseModel):
     """memory.* settings of the cognitive memory graph."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     # Anchor gate, eq. (2)
     delta_d: float = Field(1.0, gt=0.0, description="anchor when translation since last anchor > delta_d (m)")
@@ -75,7 +77,7 @@ class MemoryConfig(BaseModel):
     anchor_cost: Literal["unit", "quality"] = Field(
         "unit", description="c_i: 1 for every anchor, or 1 + quality_weight * (1 - image quality)")
     quality_weight: float = Field(1.0, ge=0.0)
-    prune_time_limit_s: float = Field(0.5, gt=0.0, description="HiGHS time limit of one pruning")
+    prune_time_limit_s: float = Field(0.5, gt=0.0, le=MAX_DURATION_S, description="HiGHS time limit of one pruning")
     keep_latest_anchor: bool = Field(True, description="never prune the newest anchor")
     keep_far_evidence: bool = Field(True, description="each label seen only beyond max_depth is an "
                                     "extra element to cover once, so pruning keeps that evidence")

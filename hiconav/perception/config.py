@@ -16,7 +16,7 @@ class OracleConfig(BaseModel):
     takes the label of a similar category (sofa <-> armchair, tv <-> laptop, ...).
     """
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     miss_rate: float = Field(0.1, ge=0.0, le=1.0, description="probability to drop a visible object")
     false_positive_rate: float = Field(
@@ -37,7 +37,7 @@ class OracleConfig(BaseModel):
 class OwlVitConfig(BaseModel):
     """The optional open-vocabulary detector (OWL-ViT / OWLv2 through transformers)."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     weights_path: str | None = Field(
         None,
@@ -52,7 +52,7 @@ class OwlVitConfig(BaseModel):
 class PerceptionConfig(BaseModel):
     """perception.* settings."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     detector: str = Field("oracle", description="registered detector name: oracle | owlvit")
     embedder: str = Field("minilm", description="registered embedder name: minilm | hashing (fallback)")

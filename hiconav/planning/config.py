@@ -4,11 +4,13 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from hiconav.limits import MAX_DURATION_S
+
 
 class LocalPlannerConfig(BaseModel):
     """planning.local.*: pure-pursuit velocity commands."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     lookahead_m: float = Field(0.5, gt=0.0, description="pure-pursuit lookahead distance")
     v_max: float = Field(0.5, gt=0.0, description="max forward speed (m/s)")
@@ -26,7 +28,7 @@ class LocalPlannerConfig(BaseModel):
 class DiscreteConfig(BaseModel):
     """planning.discrete.*: velocity-free Habitat-style actions."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     turn_tolerance_deg: float = Field(15.0, gt=0.0, description="turn until the heading error is below this")
     forward_tolerance_deg: float = Field(
@@ -42,7 +44,7 @@ class DiscreteConfig(BaseModel):
 class NavigatorConfig(BaseModel):
     """planning.*: the Navigator (A* + local planner + recovery)."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     window_margin_m: float = Field(3.0, ge=0.0, description="A* first searches the start-goal box plus this")
     plan_through_unknown: bool = Field(False, description="let A* cross unknown cells")
@@ -79,8 +81,8 @@ class NavigatorConfig(BaseModel):
                              "(status 'stuck'; 0: never give up)"
     )
     give_up_m: float = Field(0.5, ge=0.0, description="see max_recoveries")
-    back_off_s: float = Field(1.0, ge=0.0, description="velocity mode: back off this long when stuck")
+    back_off_s: float = Field(1.0, ge=0.0, le=MAX_DURATION_S, description="velocity mode: back off this long when stuck")
     back_off_speed: float = Field(0.15, ge=0.0)
-    stuck_time_s: float = Field(2.0, gt=0.0, description="velocity mode: no progress this long is stuck")
+    stuck_time_s: float = Field(2.0, gt=0.0, le=MAX_DURATION_S, description="velocity mode: no progress this long is stuck")
     local: LocalPlannerConfig = Field(default_factory=LocalPlannerConfig)
     discrete: DiscreteConfig = Field(default_factory=DiscreteConfig)

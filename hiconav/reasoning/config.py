@@ -11,6 +11,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from hiconav.limits import MAX_DURATION_S
+
 
 class VLMConfig(BaseModel):
     """One OpenAI-compatible chat endpoint (llama.cpp server, vLLM, Ollama, a hosted API).
@@ -20,18 +22,18 @@ class VLMConfig(BaseModel):
     environment variable that holds it (unset or empty = no Authorization header).
     """
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     base_url: str | None = None
     model: str = "qwen3-omni"
     api_key_env: str = "HICONAV_VLM_API_KEY"
     json_mode: bool = True  # send response_format {"type": "json_object"} (server supports it)
     vision: bool = True  # send anchor images; False for text-only models (object lists only)
-    connect_timeout_s: float = Field(5.0, gt=0)
-    timeout_s: float = Field(30.0, gt=0)  # per read, and the total deadline of one attempt
+    connect_timeout_s: float = Field(5.0, gt=0, le=MAX_DURATION_S)
+    timeout_s: float = Field(30.0, gt=0, le=MAX_DURATION_S)  # per read, and the total deadline of one attempt
     max_retries: int = Field(2, ge=0, le=10)  # extra attempts after 429 / 5xx / timeouts
-    backoff_s: float = Field(0.5, ge=0)  # first back-off; doubles each retry (exponential)
-    backoff_max_s: float = Field(8.0, ge=0)
+    backoff_s: float = Field(0.5, ge=0, le=MAX_DURATION_S)  # first back-off; doubles each retry (exponential)
+    backoff_max_s: float = Field(8.0, ge=0, le=MAX_DURATION_S)
     max_in_flight: int = Field(1, ge=1, le=2)
     max_response_bytes: int = Field(1_000_000, ge=1024)
     temperature: float = Field(0.0, ge=0, le=2)
@@ -59,7 +61,7 @@ class VLMConfig(BaseModel):
 class OfflineVerifierConfig(BaseModel):
     """The memory-graph verifier used without a VLM (labelled source="offline")."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     min_confidence: float = Field(0.5, ge=0, le=1)  # detector confidence of the object node
     min_observations: int = Field(2, ge=1)  # n_obs of the object node
@@ -69,7 +71,7 @@ class OfflineVerifierConfig(BaseModel):
 class ReasoningConfig(BaseModel):
     """Settings of the slow layer."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     backend: Literal["auto", "vlm", "offline"] = "auto"  # auto = vlm iff vlm.base_url is set
     vlm: VLMConfig = Field(default_factory=VLMConfig)
@@ -78,7 +80,7 @@ class ReasoningConfig(BaseModel):
     max_objects_per_anchor: int = Field(40, ge=1)
     confirm_confidence: float = Field(0.5, ge=0, le=1)  # a hypothesis at or above confirms
     default_vlm_confidence: float = Field(0.7, ge=0, le=1)  # when the reply gives none
-    max_latency_s: float | None = Field(None, gt=0)  # replies slower than this are "late"
+    max_latency_s: float | None = Field(None, gt=0, le=MAX_DURATION_S)  # replies slower than this are "late"
     max_attempts_per_subgraph: int = Field(2, ge=1)  # transient failures (timeouts, 5xx) retried
     fallback_to_offline: bool = True  # decomposition falls back (labelled) when the VLM fails
     max_related: int = Field(6, ge=0)

@@ -13,7 +13,7 @@ from pydantic import BaseModel, ConfigDict, Field
 class SimConfig(BaseModel):
     """Settings of one simulator instance. Lengths in metres, angles in degrees."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
     width: int = Field(640, gt=0, description="image width (pixels)")
     height: int = Field(480, gt=0, description="image height (pixels)")

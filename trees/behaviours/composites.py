@@ -8,10 +8,12 @@ arguments, so they must be literals (no ``{key}``).
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any
 
 import py_trees
+from hiconav.limits import MAX_DURATION_S
 from hiconav.trees.registry import BEHAVIOURS, NodeSpec, Param
 
 Status = py_trees.common.Status
@@ -40,7 +42,7 @@ class ClockTimeout(py_trees.decorators.Timeout):
 
 
 def _literal(**params: Param) -> dict[str, Param]:
-    return {k: Param(p.type, p.default, p.minimum, p.maximum, p.choices, False, p.doc) for k, p in params.items()}
+    return {k: dataclasses.replace(p, blackboard=False) for k, p in params.items()}
 
 
 _POLICIES = {"all": py_trees.common.ParallelPolicy.SuccessOnAll, "one": py_trees.common.ParallelPolicy.SuccessOnOne}
@@ -59,7 +61,8 @@ _DECORATORS = {
     "Retry": (lambda n, c, p: py_trees.decorators.Retry(n, c, num_failures=p["num_failures"]),
               _literal(num_failures=Param(int, minimum=1, maximum=1000))),
     "Timeout": (lambda n, c, p: ClockTimeout(n, c, duration=float(p["duration"])),
-                _literal(duration=Param(float, minimum=1e-3, maximum=1e6, doc="seconds on the mission clock"))),
+                _literal(duration=Param(float, minimum=1e-3, maximum=MAX_DURATION_S,
+                                                doc="seconds on the mission clock"))),
     "Repeat": (lambda n, c, p: py_trees.decorators.Repeat(n, c, num_success=p["num_success"]),
                _literal(num_success=Param(int, minimum=1, maximum=100000))),
     "Inverter": (lambda n, c, p: py_trees.decorators.Inverter(n, c), {}),
