@@ -7,8 +7,9 @@ memory graph alone (labels, similarity, detector confidence, observation count) 
 hypotheses source="offline".
 
 Contract: ``verify`` never raises and never returns anything but a ``VerifyResult``; anything
-invalid, truncated, oversized, late or instruction-like becomes "not found" with a reason code
-(logged). No result carries a motion command.
+invalid, truncated, oversized, late or instruction-like, and a reply that found something other
+than the task's target, becomes "not found" with a reason code (logged). No result carries a
+motion command.
 """
 
 from __future__ import annotations
@@ -160,7 +161,8 @@ class VLMVerifier:
                               f"reply after {latency:.2f} s > max_latency_s {cfg.max_latency_s}", latency)
         try:
             reply = replies.parse_verification(result.content, index.objects_per_view,
-                                               finish_reason=result.finish_reason, message=result.message)
+                                               finish_reason=result.finish_reason, message=result.message,
+                                               labels=index.labels, targets=task.targets)
         except replies.ReplyError as exc:
             return _not_found(subgraph, self.source, exc.reason, exc.detail, latency)
         if not reply.visible:
@@ -174,7 +176,7 @@ class VLMVerifier:
         anchor_id = index.anchor_ids[reply.view]
         object_id = None if reply.object is None else index.object_ids[reply.view][reply.object]
         confidence = reply.confidence if reply.confidence is not None else self.config.default_vlm_confidence
-        label = task.targets[0] if task.targets else ""
+        label = reply.target or (task.targets[0] if task.targets else "")
         hyp = TargetHypothesis(anchor_id=anchor_id, object_id=object_id, bbox=np.asarray(reply.bbox),
                                confidence=float(confidence), evidence=reply.evidence, latency_s=latency,
                                source=self.source, subgraph_signature=tuple(subgraph.signature),
