@@ -3,7 +3,9 @@
 Owns one ``Navigator``. Goals arrive as ``GoalMsg`` (None cancels); world snapshots are
 latest-wins. One command per new snapshot (so a discrete action is never issued twice for the same
 pose); progress goes back to the mission as ``NavStatus`` ("active" | "reached" | "failed").
-``StopRequest`` sends the STOP action. It never chooses goals.
+``StopRequest`` sends the STOP action. With ``hold_while_reasoning`` (the sync_reasoning ablation) it
+sends nothing while a reasoning call is in flight (``ReasoningBusy``): the robot stands still until
+the reply, as a navigator that blocks on its VLM does. It never chooses goals.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from typing import Any
 from hiconav.actors.node import Node
 from hiconav.actors.runtime import NodeActor
 
-from hiconav.messages import CommandMsg, GoalMsg, NavStatus, StopRequest, WorldSnapshot
+from hiconav.messages import CommandMsg, GoalMsg, NavStatus, ReasoningBusy, StopRequest, WorldSnapshot
 from hiconav.types import DiscreteAction
 
 
@@ -27,7 +29,7 @@ class ControlNode(Node):
     actor_class = ControlActor
 
     def __init__(self, navigator: Any, *, rate_hz: float = 10.0, mode: str = "discrete",
-                 velocity_dt: float = 0.1) -> None:
+                 velocity_dt: float = 0.1, hold_while_reasoning: bool = False) -> None:
         super().__init__(rate_hz)
         if mode not in ("discrete", "velocity"):
             raise ValueError(f"control mode must be 'discrete' or 'velocity', got {mode!r}")
@@ -40,6 +42,10 @@ class ControlNode(Node):
         self._fresh = False
         self._stop: StopRequest | None = None
         self._cmd_seq = 0
+        self.hold_while_reasoning = hold_while_reasoning
+        self.hold_until = 0.0
+        self.held_ticks = 0
+        self.on(ReasoningBusy, lambda m, now: setattr(self, "hold_until", max(self.hold_until, m.until)))
         self.on(WorldSnapshot, self._on_snapshot)
         self.on(GoalMsg, self._on_goal)
         self.on(StopRequest, lambda m, now: setattr(self, "_stop", m))
@@ -71,6 +77,9 @@ class ControlNode(Node):
             self._fresh = False
             return
         if not self._fresh or self._snapshot is None or self.state != "active":
+            return
+        if self.hold_while_reasoning and now < self.hold_until - 1e-9:
+            self.held_ticks += 1  # keeps the snapshot fresh: act on it once the reply is in
             return
         self._fresh = False
         snap = self._snapshot

@@ -48,7 +48,7 @@ class MissionNode(Node):
 
     def __init__(self, tree: str | Path, instruction: str, *, rate_hz: float = 10.0,
                  blackboard: dict[str, Any] | None = None, success_distance: float = 1.0, verify: bool = True,
-                 use_memory_labels: bool = True, record_tree: bool = False,
+                 use_memory_labels: bool = True, reasoning: bool = True, record_tree: bool = False,
                  requalify_observations: int = 3, remap_area_m2: float = 1.0) -> None:
         super().__init__(rate_hz)
         self.tree_source = tree
@@ -57,6 +57,7 @@ class MissionNode(Node):
         self.success_distance = success_distance
         self.verify = verify
         self.use_memory_labels = use_memory_labels
+        self.reasoning = reasoning
         self.requalify_observations = requalify_observations
         self.remap_area_m2 = remap_area_m2
         self.record_tree = record_tree
@@ -84,7 +85,7 @@ class MissionNode(Node):
         self._now = now
         self.context = MissionContext(instruction=self.instruction, clock=lambda: self._now,
                                       success_distance=self.success_distance, verify=self.verify,
-                                      use_memory_labels=self.use_memory_labels,
+                                      use_memory_labels=self.use_memory_labels, reasoning=self.reasoning,
                                       requalify_observations=self.requalify_observations,
                                       remap_area_m2=self.remap_area_m2)
         self.tree = MissionTree(self.tree_source, self.context, self.blackboard)

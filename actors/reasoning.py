@@ -22,7 +22,7 @@ from typing import Any
 from hiconav.actors.node import Node
 from hiconav.actors.runtime import NodeActor
 
-from hiconav.messages import HypothesisMsg, ParseRequest, TargetRejected, TaskMsg, WorldSnapshot
+from hiconav.messages import HypothesisMsg, ParseRequest, ReasoningBusy, TargetRejected, TaskMsg, WorldSnapshot
 
 
 class ReasoningActor(NodeActor):
@@ -36,8 +36,8 @@ class ReasoningNode(Node):
     def __init__(self, *, parse: Callable[[str], Any], make_reasoner: Callable[[Any], Any] | None,
                  verifier: Any = None, decompose: Callable[..., list] | None = None,
                  similarity: Callable[[str, str], float] | None = None, k: int = 5, rate_hz: float = 10.0,
-                 stepped: bool = True, latency_s: float | None = None, parse_latency_s: float | None = None,
-                 task_to: tuple[str, ...] = ("mission", "exploration", "memory")) -> None:
+                 stepped: bool = True, latency_s: Any = None, parse_latency_s: Any = None,
+                 task_to: tuple[str, ...] = ("mission", "exploration", "memory"), sync: bool = False) -> None:
         super().__init__(rate_hz)
         self.parse = parse
         self.make_reasoner = make_reasoner
@@ -49,6 +49,7 @@ class ReasoningNode(Node):
         self.latency_s = latency_s
         self.parse_latency_s = parse_latency_s
         self.task_to = task_to
+        self.sync = sync  # tell control when a call is in flight (it holds the robot still)
         self.task = None
         self.reasoner: Any = None
         self.busy_until = 0.0
@@ -74,10 +75,18 @@ class ReasoningNode(Node):
         if self.reasoner is not None:
             self.reasoner.retract(msg.reason)
 
-    def _delay(self, configured: float | None, measured: float) -> float:
+    def _delay(self, configured: Any, measured: float) -> float:
+        """The call's delay: ``configured`` is None (the measured time), seconds, or a latency model
+        (``float(model)`` draws one call's)."""
+        value = None if configured is None else float(configured)
         if not self.stepped:
-            return max((configured or 0.0) - measured, 0.0)  # real time: the call already took `measured`
-        return configured if configured is not None else measured
+            return max((value or 0.0) - measured, 0.0)  # real time: the call already took `measured`
+        return value if value is not None else measured
+
+    def _busy(self, now: float, delay: float) -> None:
+        self.busy_until = now + (delay if self.stepped else 0.0)
+        if self.sync and delay > 0:
+            self.emit("control", ReasoningBusy(self.busy_until if self.stepped else now + delay, now))
 
     def _decompose(self, memory: Any) -> list:
         """``decompose`` of ``memory`` for the current task, memoised: a memory snapshot whose object
@@ -100,7 +109,7 @@ class ReasoningNode(Node):
             task = self.parse(request.instruction)
             delay = self._delay(self.parse_latency_s, time.perf_counter() - t0)
             self._set_task(task)
-            self.busy_until = now + (delay if self.stepped else 0.0)
+            self._busy(now, delay)
             self.events.append({"t": now, "kind": "parse", "instruction": request.instruction,
                                 "targets": list(task.targets), "related": list(task.related), "latency_s": delay})
             self.emit(self.task_to, TaskMsg(task, now + delay), delay)
@@ -118,7 +127,7 @@ class ReasoningNode(Node):
         self.reasoner.accept(result)
         self.requests += 1
         delay = self._delay(self.latency_s, float(result.latency_s))
-        self.busy_until = now + (delay if self.stepped else 0.0)
+        self._busy(now, delay)
         self.events.append({"t": now, "kind": "verify", "subgraph": getattr(subgraph, "kind", ""),
                             "found": bool(result.found), "reason": result.reason, "latency_s": delay,
                             "source": result.source})

@@ -124,6 +124,15 @@ class NavStatus:
 
 
 @dataclass(frozen=True)
+class ReasoningBusy:
+    """Reasoning -> Control (sync_reasoning only): a call is in flight until ``until`` (clock s);
+    the blocking design holds the robot still until then."""
+
+    until: float
+    stamp: float = 0.0
+
+
+@dataclass(frozen=True)
 class StopRequest:
     """Mission -> Control: end the episode with the STOP action (the robot believes it arrived)."""
 

@@ -75,8 +75,14 @@ class MissionConfig(BaseModel):
     # a candidate deferred for want of a reachable view or approach cell is due again once the known
     # free floor within 2 m of it has grown by this much (0: only when its deferral time runs out)
     remap_area_m2: float = Field(1.0, ge=0)
-    # stepped: a reply becomes visible after this (None: the measured latency of a VLM; the offline
-    # reasoner then counts as instantaneous so that same-seed runs stay identical)
+    # the reasoning layer verifies subgraphs (False, the no_reasoning ablation: memory label
+    # matches alone propose candidates, also for a described instance)
+    reasoning: bool = True
+    # the robot holds still while a reasoning call is in flight (the sync_reasoning ablation: the
+    # blocking design the paper argues against)
+    sync_reasoning: bool = False
+    # stepped: a reply becomes visible after this, overriding reasoning.latency_s (None: the model
+    # reasoning.latency_s +- reasoning.latency_jitter_s)
     vlm_latency_s: float | None = Field(None, ge=0, le=MAX_DURATION_S)
     parse_latency_s: float | None = Field(None, ge=0, le=MAX_DURATION_S)
     max_time_s: float = Field(600.0, gt=0, le=MAX_DURATION_S)  # clock seconds before the run is cut off
@@ -85,6 +91,22 @@ class MissionConfig(BaseModel):
     # user actors by import path "package.module:NodeClass" -> keyword arguments; each is a
     # hiconav.actors.Node subclass (e.g. "hiconav.actors.monitor:BatteryMonitorNode": {"capacity_s": 300})
     extra_actors: dict[str, dict[str, Any]] = Field(default_factory=dict)
+
+
+class LatencyModel:
+    """A reasoning call's modelled latency on the stepped clock: ``base`` +- ``jitter`` seconds,
+    uniform, from a generator seeded per mission (``float(model)`` draws the next call's)."""
+
+    def __init__(self, base: float, jitter: float, seed: int) -> None:
+        import numpy as np
+
+        self.base, self.jitter = float(base), min(float(jitter), float(base))
+        self._rng = np.random.default_rng([int(seed), 0x5EA5])
+
+    def __float__(self) -> float:
+        if self.jitter <= 0:
+            return self.base
+        return float(self.base + self._rng.uniform(-self.jitter, self.jitter))
 
 
 def area_config(cls: type[BaseModel], overrides: dict[str, Any], area: str) -> BaseModel:
@@ -190,13 +212,16 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     def parse(text: str) -> Any:
         return decompose_instruction(text, r_cfg, similarity=similarity)
 
-    vlm_latency, parse_latency = cfg.vlm_latency_s, cfg.parse_latency_s
-    if stepped and not use_vlm:
-        # The offline reasoner is local computation whose wall time depends on the machine's load
-        # (a first MiniLM encode takes 0.1-1 s); used as virtual delay it would make same-seed runs
-        # differ. In stepped time it counts as instantaneous unless a latency is configured.
-        vlm_latency = 0.0 if vlm_latency is None else vlm_latency
-        parse_latency = 0.0 if parse_latency is None else parse_latency
+    vlm_latency: Any = cfg.vlm_latency_s
+    parse_latency: Any = cfg.parse_latency_s
+    if stepped:
+        # Every reasoning call takes the modelled latency on the stepped clock, offline or VLM: the
+        # wall time of local computation depends on the machine's load (a first MiniLM encode
+        # takes 0.1-1 s) and would make same-seed runs differ, and a real VLM's would make them
+        # depend on the network. Seeded jitter, one draw per call.
+        model = LatencyModel(r_cfg.latency_s, r_cfg.latency_jitter_s, seed)
+        vlm_latency = model if vlm_latency is None else vlm_latency
+        parse_latency = model if parse_latency is None else parse_latency
     rates = cfg.rates
     nav_cfg = area_config(NavigatorConfig, overrides, "planning")
     driver = DriverNode(sim, start, rate_hz=rates.driver, max_steps=sim_cfg.max_steps,
@@ -205,15 +230,16 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     perception = PerceptionNode(detector, rate_hz=rates.perception)
     memory = MemoryNode(grid, cmg, rate_hz=rates.memory, prune_every=prune_every)
     reasoning = ReasoningNode(parse=parse, make_reasoner=lambda task: Reasoner(task, r_cfg),
-                              verifier=verifier, decompose=decompose, similarity=similarity, k=r_cfg.k,
+                              verifier=verifier if cfg.reasoning else None, decompose=decompose,
+                              similarity=similarity, k=r_cfg.k,
                               rate_hz=rates.reasoning, stepped=stepped, latency_s=vlm_latency,
-                              parse_latency_s=parse_latency)
+                              parse_latency_s=parse_latency, sync=cfg.sync_reasoning)
     exploration = ExplorationNode(tracker, planner, rate_hz=rates.exploration, similarity=similarity)
     control = ControlNode(Navigator(nav_cfg), rate_hz=rates.control, mode=cfg.control_mode,
-                          velocity_dt=1.0 / rates.control)
+                          velocity_dt=1.0 / rates.control, hold_while_reasoning=cfg.sync_reasoning)
     mission = MissionNode(tree or cfg.tree, instruction, rate_hz=rates.mission,
                           success_distance=sim_cfg.success_distance, verify=cfg.verify,
-                          use_memory_labels=cfg.use_memory_labels,
+                          use_memory_labels=cfg.use_memory_labels, reasoning=cfg.reasoning,
                           requalify_observations=cfg.requalify_observations,
                           remap_area_m2=cfg.remap_area_m2, record_tree=record is not None or spawn)
     nodes = [driver, perception, memory, reasoning, exploration, control, mission]
@@ -424,6 +450,7 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
         detector=result.detector, reasoner=result.reasoner, error=result.failure,
         error_kind="runtime" if result.failure else None,
         extra={"mission": result.mission_status, "fallbacks": result.fallbacks,
+               "reasoning_calls": int(sum(1 for e in result.reasoning_events if e["kind"] == "verify")),
                "feedback": result.mission_feedback,
                "shortest_to_success": float(m.shortest_to_success),  # SPL's l (docs/evaluation.md)
                "dropped": {k: dict(v.dropped) for k, v in result.stats.items() if v.dropped}})

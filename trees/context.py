@@ -60,6 +60,9 @@ class MissionContext:
     success_distance: float = 1.0
     robot_radius: float = 0.18
     use_memory_labels: bool = True
+    # the reasoning layer verifies subgraphs: for a described instance (relations on the target)
+    # only its verdict proposes candidates; without it (the no_reasoning ablation) labels do
+    reasoning: bool = True
     verify: bool = True  # False: VerifyTarget accepts the candidate as is (the 'no_verify' ablation)
     task: TaskSpec | None = None
     world: Any = None  # WorldSnapshot
@@ -239,7 +242,7 @@ class MissionContext:
                 continue
             seen.add(oid)
             out.append(self.candidate_of(objects[oid], "hypothesis", float(getattr(hyp, "confidence", 0.0))))
-        if self.use_memory_labels:
+        if self.use_memory_labels and not (self.reasoning and self.described):
             targets = set(self.task.targets)
             matches = [o for o in memory.objects if o.label in targets and not self.excluded(o.id)
                        and o.id not in seen]
@@ -254,6 +257,14 @@ class MissionContext:
                 matches.sort(key=lambda o: (-o.confidence * o.n_obs, o.id))
             out += [self.candidate_of(o, "memory-label", float(o.confidence)) for o in matches]
         return out
+
+    @property
+    def described(self) -> bool:
+        """The instruction singles out one instance by relations on the target ("the armchair next
+        to the floor lamp"): a label match then proposes nothing, the reasoning layer decides."""
+        from hiconav.reasoning.grounding import target_relations
+
+        return self.task is not None and bool(target_relations(self.task.relations, self.task.targets))
 
     def _resolve(self, hyp: Any, memory: Any, objects: dict[int, Any]) -> int | None:
         oid = getattr(hyp, "object_id", None)

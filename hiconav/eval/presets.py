@@ -21,6 +21,8 @@ from hiconav.settings import nest  # noqa: F401  (re-exported: runners with nest
 #   exploration.utility.use_vis     S_vis on/off (out-of-boundary visual evidence)
 #   memory.prune                    ILP anchor pruning (weighted set multicover) on/off
 #   mission.verify                  VerifyTarget with fresh views before stopping on/off
+#   mission.reasoning               subgraph verification by the reasoning layer on/off
+#   mission.sync_reasoning          the robot holds still while a reasoning call is in flight
 PRESETS: dict[str, dict[str, Any]] = {
     "full": {},
     "greedy_nearest": {"exploration.ordering.ordering": "nearest", "exploration.utility.use_struct": False,
@@ -30,6 +32,8 @@ PRESETS: dict[str, dict[str, Any]] = {
     "no_vis": {"exploration.utility.use_vis": False},
     "no_ilp": {"memory.prune": False},
     "no_verify": {"mission.verify": False},
+    "no_reasoning": {"mission.reasoning": False},
+    "sync_reasoning": {"mission.sync_reasoning": True},
 }
 
 #: What each preset removes, as the report's ablation table labels it.
@@ -41,6 +45,8 @@ DESCRIPTIONS: dict[str, str] = {
     "no_vis": "w/o out-of-boundary score S_vis",
     "no_ilp": "w/o ILP anchor pruning",
     "no_verify": "w/o target verification",
+    "no_reasoning": "w/o reasoning (memory label matches only)",
+    "sync_reasoning": "synchronous reasoning (robot holds during each call)",
 }
 
 GROUPS: dict[str, tuple[str, ...]] = {"ablations": tuple(PRESETS)}

@@ -86,6 +86,11 @@ class ReasoningConfig(BaseModel):
     max_related: int = Field(6, ge=0)
     label_similarity_threshold: float = Field(0.62, ge=0, le=1)  # noun -> vocabulary by embedding
     vocabulary: tuple[str, ...] | None = None  # None = hiconav.reasoning.decompose.DEFAULT_VOCABULARY
+    # The stepped clock's model of a reasoning call (decomposition or subgraph verification,
+    # offline or VLM): its reply becomes visible latency_s +- latency_jitter_s (uniform, seeded)
+    # after the request, as from a fast hosted VLM; 0 makes every call instantaneous
+    latency_s: float = Field(2.0, ge=0, le=MAX_DURATION_S)
+    latency_jitter_s: float = Field(0.5, ge=0, le=MAX_DURATION_S)
 
     def use_vlm(self) -> bool:
         """Whether the VLM backend is selected (an endpoint is configured and not forced off)."""

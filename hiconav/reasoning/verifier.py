@@ -22,6 +22,8 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from hiconav.reasoning.grounding import ground, infer_rooms, target_relations
+
 from hiconav.reasoning import replies
 from hiconav.reasoning.config import ReasoningConfig
 from hiconav.reasoning.hypothesis import TargetHypothesis
@@ -40,6 +42,8 @@ INTERNAL = "internal_error"
 NO_MATCH = "no_matching_object"
 FEW_OBSERVATIONS = "insufficient_observations"
 LOW_CONFIDENCE = "low_confidence"
+RELATION_FAILED = "relation_failed"  # a described instance: another instance, or the description does not fit
+RELATION_UNKNOWN = "relation_unverified"  # a described instance: the related objects or room not seen yet
 # Failures of the transport rather than of the answer: the reasoner may ask again.
 TRANSIENT = frozenset({"timeout", "transport", "truncated", "cancelled", "late", "http_408", "http_409",
                        "http_425", "http_429", "http_500", "http_502", "http_503", "http_504"})
@@ -192,8 +196,12 @@ class OfflineVerifier:
 
     An object node supports the target when its label equals a target label (or has similarity
     >= ``min_similarity`` to it), its detector confidence is >= ``min_confidence`` and it was
-    observed >= ``min_observations`` times. The hypothesis uses the anchor in which the node's
-    box is largest. Attributes and relations are not checked (said in the evidence).
+    observed >= ``min_observations`` times. When the instruction describes one instance (relations
+    whose subject is the target: "the armchair next to the floor lamp in the living room"), the
+    node must also satisfy every such relation on the subgraph (``grounding.ground``: rooms
+    inferred from the objects seen with it, relations on the nodes' 3D boxes). The hypothesis
+    uses the anchor in which the node's box is largest. Attributes are not checked (said in the
+    evidence).
     """
 
     source = "offline"
@@ -234,6 +242,9 @@ class OfflineVerifier:
         anchors = list(subgraph.anchors)
         best: tuple | None = None
         reasons: list[str] = []
+        described = bool(target_relations(task.relations, task.targets))
+        rooms = infer_rooms(list(subgraph.objects)) if described else None
+        groundings: dict[int, Any] = {}
         for obj in subgraph.objects:
             score, target = self._match(obj.label, task.targets)
             if score < 1.0 and score < cfg.min_similarity:
@@ -248,21 +259,31 @@ class OfflineVerifier:
             if view is None:
                 reasons.append(NO_MATCH)
                 continue
+            if described:
+                verdict = ground(obj, list(subgraph.objects), task.relations, task.targets, rooms)
+                groundings[obj.id] = verdict
+                if verdict.status != "holds":
+                    reasons.append(RELATION_FAILED if verdict.status == "fails" else RELATION_UNKNOWN)
+                    continue
             key = (score * obj.confidence, obj.n_obs, -obj.id)
             if best is None or key > best[0]:
                 best = (key, obj, score, target, view)
         latency = time.perf_counter() - t0
         if best is None:
-            reason = FEW_OBSERVATIONS if FEW_OBSERVATIONS in reasons else \
-                LOW_CONFIDENCE if LOW_CONFIDENCE in reasons else NO_MATCH
+            reason = next((r for r in (RELATION_UNKNOWN, RELATION_FAILED, FEW_OBSERVATIONS, LOW_CONFIDENCE)
+                           if r in reasons), NO_MATCH)
+            detail = "; ".join(f"#{oid}: {' | '.join(g.evidence)}" for oid, g in groundings.items())
             return _not_found(subgraph, self.source, reason,
-                              f"no object node supports {'/'.join(task.targets)} ({reason})", latency)
+                              f"no object node supports {'/'.join(task.targets)} ({reason})"
+                              + (f": {detail}" if detail else ""), latency)
         _, obj, score, target, (anchor, bbox) = best
         attrs = [a for t in task.targets for a in task.attributes.get(t, ())]
         evidence = (f"offline: object node {obj.id} labelled {obj.label!r} (similarity {score:.2f} to "
                     f"{target!r}), detector confidence {obj.confidence:.2f}, seen {obj.n_obs} times")
         if attrs:
             evidence += f"; attributes not checked: {', '.join(attrs)}"
+        if obj.id in groundings:
+            evidence += "; " + "; ".join(groundings[obj.id].evidence)
         hyp = TargetHypothesis(anchor_id=int(anchor.id), object_id=int(obj.id), bbox=bbox,
                                confidence=float(score * obj.confidence), evidence=evidence,
                                latency_s=latency, source=self.source,

@@ -37,7 +37,7 @@ TARGET_CATEGORIES: tuple[str, ...] = (
 # that results of episodes generated under other rules are never resumed as if they were these.
 EPISODE_RULES = ("goals: instances with >= 150 px from a view point; footprints at least one cell wide; "
                  "gibson: SemExp's protocol (channel 0 is the centre's free space, fast marching, "
-                 "every instance of the category, start 1.5-100 m)")
+                 "visible instances of the category, start 1.5-100 m)")
 
 
 SEMEXP_MAX_DISTANCE = 100.0  # m: SemExp's max_d for generated Gibson episodes
@@ -85,11 +85,10 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
 
     The target is drawn uniformly among the categories in ``categories`` (default
     ``GIBSON_GOAL_CATEGORIES`` for Gibson houses, as in Gibson ObjectNav, else
-    ``TARGET_CATEGORIES``) that are present and reachable; the start is a uniformly drawn free
+    ``TARGET_CATEGORIES``) that are present, visible and reachable; the start is a uniformly drawn free
     cell whose geodesic distance to the target lies in [min_distance, max_distance], with a
     uniform yaw. Raises ``DataError`` if the house has no reachable target category. Under the
-    "semexp" success rule (Gibson) episodes are drawn as SemExp's generator draws them: every
-    instance of the category is a goal and ``max_distance`` is at least 100 m.
+    "semexp" success rule (Gibson) ``max_distance`` is at least 100 m, as in SemExp's generator.
 
     Goal instances are only those a camera sees: at least ``min_view_pixels`` pixels in a view
     from one of their view points (``viewpoints.viewable_instances``, as Habitat's ObjectNav
@@ -101,9 +100,11 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
     semexp = house.success_rule == "semexp"
     allowed = categories or (GIBSON_GOAL_CATEGORIES if semexp else TARGET_CATEGORIES)
     if semexp:
-        # SemExp's generator (objectgoal_env.generate_new_episode): the goal is every cell of the
-        # category, visible or not, and the start lies 1.5-100 m (its min_d, max_d) from the goal
-        min_view_pixels = None
+        # SemExp's generator (objectgoal_env.generate_new_episode): the start lies 1.5-100 m (its
+        # min_d, max_d) from the goal. Its goal is every cell of the category; ours keeps the
+        # instances a camera sees, as for ProcTHOR: a room the navmesh lacks (a bathroom whose floor
+        # is missing from channel 0) is drawn as a solid block, and the toilet in it shows in no
+        # pixel from anywhere, though Habitat renders it
         max_distance = max(max_distance, SEMEXP_MAX_DISTANCE)
     present = sorted(c for c in house.categories if c in allowed)
     rng = np.random.default_rng(seed)

@@ -1,0 +1,228 @@
+"""Grounding a described instance on the memory graph: rooms inferred from what the robot saw,
+and the spatial relations of an instruction checked on object nodes' 3D boxes.
+
+"The armchair next to the floor lamp in the living room" decomposes (``decompose``) into the
+target ``armchair`` and the relations (armchair, next to, floor_lamp), (armchair, in,
+living_room), (floor_lamp, in, living_room). A label match proposes an armchair; only this
+module's verdict says which armchair the words single out. It is the offline reasoner's rule
+for a subgraph (the VLM path answers the same question from the subgraph's images).
+
+* **Rooms** are never read from a house's ground truth: each object node's room type is inferred
+  from the room-defining objects the robot saw with it (``ROOM_CUES``: a bed makes a bedroom, a
+  toilet a bathroom, a fridge a kitchen, a sofa a living room), weighted by a cue's strength and
+  by ``exp(-d / ROOM_DECAY_M)`` of its planar distance, counted only for nodes observed from a
+  common anchor (co-visible objects share a room far more often than objects behind a wall).
+* **Relations** are predicates on axis-aligned boxes (world metres): ``next to`` a planar gap of
+  at most ``NEXT_TO_M``, ``near`` at most ``NEAR_M``, ``on`` resting on the other's top, ``under``
+  and ``above`` overlapping in plan one below the other, ``in`` a room (or inside a box),
+  ``between`` near both. View-dependent words (left of, behind, facing, ...) have no fixed
+  meaning without the speaker's viewpoint and are read as ``near`` (a labelled approximation).
+
+Verdicts are "holds", "fails" or "unknown" (the related object is not in the subgraph, or no room
+can be inferred), so a described instance is confirmed only when every relation holds. Pure
+functions; no I/O, no clocks.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+NEXT_TO_M = 1.0  # m: planar gap between two boxes that reads "next to" / "beside"
+NEAR_M = 2.0  # m: planar gap that reads "near"
+ON_GAP_M = 0.30  # m: a box whose bottom lies this close to another's top rests on it
+ROOM_DECAY_M = 2.5  # m: a room cue's weight falls by e over this planar distance
+ROOM_REACH_M = 6.0  # m: cues farther than this say nothing of an object's room
+ROOM_MIN_SCORE = 0.8  # below this evidence the room is unknown
+
+ROOMS: tuple[str, ...] = ("bedroom", "bathroom", "kitchen", "living_room")
+# Aliases people use for the four room types (the parser maps them to these labels or keeps them).
+ROOM_ALIASES: dict[str, str] = {
+    "bedroom": "bedroom", "bed_room": "bedroom", "master_bedroom": "bedroom", "guest_room": "bedroom",
+    "bathroom": "bathroom", "bath_room": "bathroom", "restroom": "bathroom", "washroom": "bathroom",
+    "toilet_room": "bathroom", "lavatory": "bathroom",
+    "kitchen": "kitchen", "kitchenette": "kitchen",
+    "living_room": "living_room", "livingroom": "living_room", "lounge": "living_room",
+    "sitting_room": "living_room", "family_room": "living_room", "den": "living_room",
+}
+# category -> ((room, weight), ...): how strongly seeing it says which room one is in.
+ROOM_CUES: dict[str, tuple[tuple[str, float], ...]] = {
+    "bed": (("bedroom", 3.0),), "dresser": (("bedroom", 1.5),), "alarm_clock": (("bedroom", 1.0),),
+    "desk": (("bedroom", 0.7),), "desk_lamp": (("bedroom", 0.5),), "laundry_hamper": (("bedroom", 0.5), ("bathroom", 0.5)),
+    "teddy_bear": (("bedroom", 0.7),),
+    "toilet": (("bathroom", 3.0),), "bathtub": (("bathroom", 3.0),), "shower": (("bathroom", 3.0),),
+    "shower_curtain": (("bathroom", 2.0),), "toilet_paper": (("bathroom", 2.0),), "towel_holder": (("bathroom", 1.5),),
+    "hand_towel": (("bathroom", 1.0),), "plunger": (("bathroom", 2.0),), "soap_bar": (("bathroom", 1.0),),
+    "fridge": (("kitchen", 3.0),), "oven": (("kitchen", 3.0),), "stove": (("kitchen", 3.0),),
+    "stove_burner": (("kitchen", 3.0),), "microwave": (("kitchen", 2.0),), "coffee_machine": (("kitchen", 2.0),),
+    "toaster": (("kitchen", 2.0),), "dishwasher": (("kitchen", 2.0),), "counter_top": (("kitchen", 1.5),),
+    "sink": (("kitchen", 1.0), ("bathroom", 1.0)), "kettle": (("kitchen", 1.0),), "pan": (("kitchen", 1.0),),
+    "pot": (("kitchen", 1.0),), "garbage_can": (("kitchen", 0.3),),
+    "sofa": (("living_room", 3.0),), "tv_stand": (("living_room", 2.0),), "coffee_table": (("living_room", 2.0),),
+    "tv": (("living_room", 1.5),), "armchair": (("living_room", 1.5),), "floor_lamp": (("living_room", 0.7),),
+    "ottoman": (("living_room", 1.0),), "dining_table": (("living_room", 0.5), ("kitchen", 0.5)),
+}
+NEAR_WORDS = frozenset(["near", "left of", "right of", "in front of", "behind", "facing", "opposite", "at",
+                        "with", "against", "by"])
+
+
+class BoxLike(Protocol):
+    id: int
+    label: str
+    box_min: Any  # (3,) world metres
+    box_max: Any
+    anchor_ids: Any
+
+
+def room_of(label: str) -> str | None:
+    """The room type a relation's object names ("living room" -> "living_room"), or None."""
+    key = label.strip().lower().replace(" ", "_").replace("-", "_")
+    return ROOM_ALIASES.get(key)
+
+
+# ------------------------------------------------------------------------------------ geometry
+def planar_gap(a: BoxLike, b: BoxLike) -> float:
+    """Planar distance (m) between the footprints of two boxes; 0 when they overlap in plan."""
+    a0, a1 = np.asarray(a.box_min, float), np.asarray(a.box_max, float)
+    b0, b1 = np.asarray(b.box_min, float), np.asarray(b.box_max, float)
+    dx = max(b0[0] - a1[0], a0[0] - b1[0], 0.0)
+    dy = max(b0[1] - a1[1], a0[1] - b1[1], 0.0)
+    return math.hypot(dx, dy)
+
+
+def _plan_overlap(a: BoxLike, b: BoxLike, pad: float = 0.05) -> bool:
+    a0, a1 = np.asarray(a.box_min, float), np.asarray(a.box_max, float)
+    b0, b1 = np.asarray(b.box_min, float), np.asarray(b.box_max, float)
+    return bool(a0[0] <= b1[0] + pad and b0[0] <= a1[0] + pad and a0[1] <= b1[1] + pad and b0[1] <= a1[1] + pad)
+
+
+def _centre_in_plan(a: BoxLike, b: BoxLike, pad: float = 0.10) -> bool:
+    c = (np.asarray(a.box_min, float) + np.asarray(a.box_max, float)) / 2.0
+    b0, b1 = np.asarray(b.box_min, float), np.asarray(b.box_max, float)
+    return bool(b0[0] - pad <= c[0] <= b1[0] + pad and b0[1] - pad <= c[1] <= b1[1] + pad)
+
+
+def relation_holds(relation: str, a: BoxLike, b: BoxLike) -> bool:
+    """Whether ``a`` stands in ``relation`` to ``b`` (both object boxes; see the module's list)."""
+    rel = relation.strip().lower()
+    if rel == "on":
+        return _centre_in_plan(a, b) and abs(float(a.box_min[2]) - float(b.box_max[2])) <= ON_GAP_M
+    if rel in ("under", "below"):
+        return _plan_overlap(a, b) and float(b.box_min[2]) >= float(a.box_max[2]) - ON_GAP_M
+    if rel == "above":
+        return _plan_overlap(a, b) and float(a.box_min[2]) >= float(b.box_max[2]) - ON_GAP_M
+    if rel == "in":
+        return _centre_in_plan(a, b, pad=0.0) and float(b.box_min[2]) - 0.1 <= float(a.box_min[2]) <= float(b.box_max[2])
+    if rel == "next to":
+        return planar_gap(a, b) <= NEXT_TO_M
+    return planar_gap(a, b) <= NEAR_M  # near and the view-dependent words
+
+
+# ---------------------------------------------------------------------------------------- rooms
+def infer_rooms(objects: Sequence[BoxLike]) -> dict[int, tuple[str | None, float]]:
+    """Object id -> (inferred room type or None, its evidence score) for every object.
+
+    An object's room scores sum, over the objects co-visible with it (a common anchor) within
+    ``ROOM_REACH_M`` and over itself, each cue weight x exp(-gap / ROOM_DECAY_M)."""
+    out: dict[int, tuple[str | None, float]] = {}
+    anchors = {o.id: set(getattr(o, "anchor_ids", ()) or ()) for o in objects}
+    for o in objects:
+        scores: dict[str, float] = {}
+        for other in objects:
+            cues = ROOM_CUES.get(other.label)
+            if not cues:
+                continue
+            if other.id != o.id and not (anchors[o.id] & anchors[other.id]):
+                continue
+            gap = 0.0 if other.id == o.id else planar_gap(o, other)
+            if gap > ROOM_REACH_M:
+                continue
+            w = math.exp(-gap / ROOM_DECAY_M)
+            for room, weight in cues:
+                scores[room] = scores.get(room, 0.0) + weight * w
+        if not scores:
+            out[o.id] = (None, 0.0)
+            continue
+        room, score = max(scores.items(), key=lambda kv: (kv[1], kv[0]))
+        out[o.id] = (room if score >= ROOM_MIN_SCORE else None, score)
+    return out
+
+
+# -------------------------------------------------------------------------------------- verdict
+@dataclass(frozen=True)
+class Grounding:
+    """The verdict on one candidate object: ``status`` "holds" | "fails" | "unknown", with one
+    line of evidence per relation."""
+
+    object_id: int
+    status: str
+    evidence: tuple[str, ...]
+
+
+def _labels_match(label: str, name: str) -> bool:
+    return label.strip().lower().replace(" ", "_") == name.strip().lower().replace(" ", "_")
+
+
+def target_relations(relations: Iterable[Sequence[str]], targets: Iterable[str]) -> list[tuple[str, str, str]]:
+    """The relations whose subject is one of ``targets``: what singles out the described instance."""
+    names = {t.strip().lower().replace(" ", "_") for t in targets}
+    return [(s, r, o) for s, r, o in (tuple(x) for x in relations) if s.strip().lower().replace(" ", "_") in names]
+
+
+def ground(candidate: BoxLike, objects: Sequence[BoxLike], relations: Sequence[Sequence[str]],
+           targets: Sequence[str], rooms: dict[int, tuple[str | None, float]] | None = None) -> Grounding:
+    """Check every relation of ``relations`` whose subject is a target on ``candidate``.
+
+    ``objects``: the nodes to ground on (the subgraph's; ``candidate`` among them); relations of a
+    related object ("the floor lamp in the living room") are checked one level down, on the node
+    that satisfied the target's relation. Holds only when every relation holds.
+    """
+    rooms = rooms if rooms is not None else infer_rooms(objects)
+    rels = target_relations(relations, targets)
+    if not rels:
+        return Grounding(candidate.id, "holds", ("no relation to check",))
+    evidence: list[str] = []
+    statuses: list[str] = []
+    for subject, rel, obj in rels:
+        status, line = _one(candidate, rel, obj, objects, relations, rooms, depth=0)
+        statuses.append(status)
+        evidence.append(f"{subject} {rel} {obj}: {status} ({line})")
+    status = "fails" if "fails" in statuses else ("unknown" if "unknown" in statuses else "holds")
+    return Grounding(candidate.id, status, tuple(evidence))
+
+
+def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relations: Sequence[Sequence[str]],
+         rooms: dict[int, tuple[str | None, float]], depth: int) -> tuple[str, str]:
+    room = room_of(obj)
+    if room is not None and rel.strip().lower() in ("in", "at", "inside", "within"):
+        seen, score = rooms.get(node.id, (None, 0.0))
+        if seen is None:
+            return "unknown", "no room cue seen with it"
+        return ("holds" if seen == room else "fails"), f"inferred {seen} (evidence {score:.1f})"
+    others = [o for o in objects if o.id != node.id and _labels_match(o.label, obj)]
+    if not others:
+        return "unknown", f"no {obj} in view"
+    best = "fails"
+    line = ""
+    for other in sorted(others, key=lambda o: planar_gap(node, o)):
+        if not relation_holds(rel, node, other):
+            continue
+        nested = [(r, o2) for s2, r, o2 in (tuple(x) for x in relations)
+                  if _labels_match(s2, obj) and not _labels_match(o2, node.label)]
+        if depth == 0 and nested:
+            sub = [_one(other, r, o2, objects, relations, rooms, depth=1)[0] for r, o2 in nested]
+            if "fails" in sub:
+                line = f"#{other.id} is {rel} it, but not {', '.join(f'{r} {o2}' for r, o2 in nested)}"
+                continue
+            if "unknown" in sub:
+                best, line = "unknown", f"#{other.id} is {rel} it; {', '.join(f'{r} {o2}' for r, o2 in nested)} unknown"
+                continue
+        return "holds", f"#{other.id} at {planar_gap(node, other):.2f} m"
+    if not line:
+        line = f"nearest {obj} #{min(others, key=lambda o: planar_gap(node, o)).id} at " \
+               f"{min(planar_gap(node, o) for o in others):.2f} m"
+    return best, line

@@ -1,0 +1,158 @@
+"""Grounding a described instance on the memory graph: rooms from what was seen, relations on
+boxes, and the offline verifier's verdict (issue #27: the reasoning layer decides)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hiconav.reasoning.config import ReasoningConfig
+from hiconav.reasoning.decompose import decompose_instruction
+from hiconav.reasoning.grounding import ground, infer_rooms, planar_gap, relation_holds, room_of
+from hiconav.reasoning.verifier import FOUND, RELATION_UNKNOWN, OfflineVerifier
+
+
+@dataclass(frozen=True)
+class Node:
+    id: int
+    label: str
+    box_min: np.ndarray
+    box_max: np.ndarray
+    anchor_ids: tuple[int, ...] = (1,)
+    confidence: float = 0.9
+    n_obs: int = 4
+    center: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+
+def node(i, label, xy, size=(0.6, 0.6), z=(0.0, 0.9), anchors=(1,)):
+    lo = np.array([xy[0] - size[0] / 2, xy[1] - size[1] / 2, z[0]])
+    hi = np.array([xy[0] + size[0] / 2, xy[1] + size[1] / 2, z[1]])
+    return Node(i, label, lo, hi, tuple(anchors), center=(lo + hi) / 2)
+
+
+@dataclass(frozen=True)
+class Anchor:
+    id: int
+    object_ids: tuple[int, ...]
+    boxes: np.ndarray
+    image: np.ndarray = field(default_factory=lambda: np.zeros((8, 8, 3), np.uint8))
+    labels_seen: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Graph:
+    kind: str
+    anchors: tuple
+    objects: tuple
+    priority: float = 1.0
+    signature: tuple = ("t",)
+
+
+def graph(objects):
+    anchors = {}
+    for o in objects:
+        for a in o.anchor_ids:
+            anchors.setdefault(a, []).append(o.id)
+    views = tuple(Anchor(a, tuple(ids), np.tile([0.2, 0.2, 0.6, 0.6], (len(ids), 1))) for a, ids in sorted(anchors.items()))
+    return Graph("target", views, tuple(objects))
+
+
+# ------------------------------------------------------------------------------- predicates
+
+
+def test_next_to_is_a_planar_gap_of_at_most_a_metre():
+    a, b, c = node(1, "armchair", (0, 0)), node(2, "floor_lamp", (1.2, 0), (0.3, 0.3)), node(3, "floor_lamp", (2.5, 0))
+    assert abs(planar_gap(a, b) - 0.75) < 1e-9
+    assert relation_holds("next to", a, b) and not relation_holds("next to", a, c)
+    assert relation_holds("near", a, c)  # a 1.9 m gap
+    assert not relation_holds("near", a, node(4, "floor_lamp", (3.0, 0)))  # 2.4 m
+
+
+def test_on_means_resting_on_the_other_top_and_under_the_reverse():
+    counter = node(1, "counter_top", (0, 0), (2.0, 0.6), (0.0, 0.9))
+    mug = node(2, "mug", (0.3, 0.1), (0.1, 0.1), (0.9, 1.0))
+    floor_mug = node(3, "mug", (0.3, 0.1), (0.1, 0.1), (0.0, 0.1))
+    assert relation_holds("on", mug, counter) and not relation_holds("on", floor_mug, counter)
+    table = node(4, "dining_table", (0, 0), (1.2, 0.8), (0.0, 0.75))
+    cat_bed = node(5, "dog_bed", (0.1, 0.0), (0.5, 0.4), (0.0, 0.2))
+    assert relation_holds("under", cat_bed, table) and not relation_holds("under", table, cat_bed)
+
+
+def test_room_words_map_to_the_four_room_types():
+    assert room_of("living room") == "living_room" and room_of("lounge") == "living_room"
+    assert room_of("restroom") == "bathroom" and room_of("floor_lamp") is None
+
+
+def test_a_room_is_inferred_from_the_objects_seen_with_it_not_through_walls():
+    chair = node(1, "chair", (0, 0), anchors=(1,))
+    bed = node(2, "bed", (1.5, 0), (2.0, 1.6), anchors=(1,))
+    fridge = node(3, "fridge", (-1.5, 0), anchors=(2,))  # never seen with the chair
+    rooms = infer_rooms([chair, bed, fridge])
+    assert rooms[1][0] == "bedroom"
+    assert rooms[3][0] == "kitchen"
+    lonely = node(4, "chair", (10, 10), anchors=(3,))
+    assert infer_rooms([lonely, bed])[4] == (None, 0.0)
+
+
+# ---------------------------------------------------------------------------------- verdicts
+
+
+def _living_room_scene():
+    """Two armchairs: #1 beside a floor lamp with a sofa in view, #2 by a bed across the house."""
+    return [
+        node(1, "armchair", (0, 0), anchors=(1,)),
+        node(2, "floor_lamp", (0.9, 0), (0.3, 0.3), (0.0, 1.6), anchors=(1,)),
+        node(3, "sofa", (0, 2.0), (2.0, 0.9), anchors=(1,)),
+        node(4, "armchair", (8, 0), anchors=(2,)),
+        node(5, "bed", (9.5, 0), (2.0, 1.6), anchors=(2,)),
+    ]
+
+
+TASK = decompose_instruction("the armchair next to the floor lamp in the living room", ReasoningConfig(),
+                             similarity=None)
+
+
+def test_the_described_instance_holds_and_the_other_instance_does_not():
+    objects = _living_room_scene()
+    right = ground(objects[0], objects, TASK.relations, TASK.targets)
+    wrong = ground(objects[3], objects, TASK.relations, TASK.targets)
+    assert right.status == "holds", right.evidence
+    assert wrong.status == "fails", wrong.evidence  # no lamp beside it, and it stands in a bedroom
+
+
+def test_a_relation_to_an_object_not_yet_seen_is_unknown_not_a_failure():
+    objects = [node(1, "armchair", (0, 0)), node(3, "sofa", (0, 2.0), (2.0, 0.9))]
+    verdict = ground(objects[0], objects, TASK.relations, TASK.targets)
+    assert verdict.status == "unknown"
+
+
+def test_a_related_object_must_satisfy_its_own_relations():
+    # the lamp beside the armchair stands in a bedroom: "the floor lamp in the living room" fails
+    objects = [node(1, "armchair", (0, 0)), node(2, "floor_lamp", (0.9, 0), (0.3, 0.3)),
+               node(5, "bed", (1.0, 1.5), (2.0, 1.6))]
+    relations = (("armchair", "next to", "floor_lamp"), ("floor_lamp", "in", "living_room"))
+    assert ground(objects[0], objects, relations, ("armchair",)).status != "holds"
+
+
+def test_an_instruction_without_relations_on_the_target_holds_at_once():
+    objects = _living_room_scene()
+    task = decompose_instruction("find the armchair", ReasoningConfig(), similarity=None)
+    assert ground(objects[3], objects, task.relations, task.targets).status == "holds"
+
+
+def test_the_offline_verifier_confirms_only_the_described_instance():
+    verifier = OfflineVerifier(ReasoningConfig())
+    result = verifier.verify(graph(_living_room_scene()), TASK)
+    assert result.found and result.reason == FOUND
+    assert result.hypothesis.object_id == 1
+    assert "next to floor_lamp: holds" in result.hypothesis.evidence
+    only_the_other = graph([o for o in _living_room_scene() if o.id in (4, 5)])
+    missed = verifier.verify(only_the_other, TASK)
+    assert not missed.found and "relation" in missed.reason
+
+
+def test_the_offline_verifier_waits_for_the_related_object():
+    verifier = OfflineVerifier(ReasoningConfig())
+    result = verifier.verify(graph([node(1, "armchair", (0, 0)), node(3, "sofa", (0, 2.0), (2.0, 0.9))]), TASK)
+    assert not result.found and result.reason == RELATION_UNKNOWN
