@@ -149,7 +149,7 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     from hiconav.actors.mission import MissionNode
     from hiconav.actors.perception import PerceptionNode
     from hiconav.actors.reasoning import ReasoningNode
-    from hiconav.mapping import FrontierTracker, MappingConfig, OccupancyGrid
+    from hiconav.mapping import FrontierTracker, MappingConfig, OccupancyGrid, PoseGate
     from hiconav.planning import Navigator
     from hiconav.planning.config import NavigatorConfig
     from hiconav.sim import SimConfig, Simulator
@@ -228,7 +228,8 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
                         velocity_dt=1.0 / rates.control, lockstep=robot is not None,
                         stream=not stepped)
     perception = PerceptionNode(detector, rate_hz=rates.perception)
-    memory = MemoryNode(grid, cmg, rate_hz=rates.memory, prune_every=prune_every)
+    memory = MemoryNode(grid, cmg, rate_hz=rates.memory, prune_every=prune_every,
+                        pose_gate=PoseGate(mapping_cfg.pose_gate))  # type: ignore[attr-defined]
     reasoning = ReasoningNode(parse=parse, make_reasoner=lambda task: Reasoner(task, r_cfg),
                               verifier=verifier if cfg.reasoning else None, decompose=decompose,
                               similarity=similarity, k=r_cfg.k,

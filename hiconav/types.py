@@ -21,6 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from hiconav.errors import FrameError
+
 
 def freeze(array: np.ndarray | None) -> np.ndarray | None:
     """Return ``array`` marked read-only (no copy) so it can be shared between threads."""
@@ -30,6 +32,31 @@ def freeze(array: np.ndarray | None) -> np.ndarray | None:
     if array.flags.writeable:
         array.flags.writeable = False
     return array
+
+
+def _finite(value: Any) -> bool:
+    try:
+        return math.isfinite(float(value))
+    except (TypeError, ValueError):
+        return False
+
+
+def check_intrinsics(k: Any, where: str = "intrinsics") -> None:
+    """Raise ``FrameError`` naming the field unless ``k`` has a positive whole width and height,
+    finite positive focal lengths and a finite principal point (a zero or NaN focal length would
+    put non-finite points into every map and object built from the frame)."""
+    for name in ("width", "height"):
+        v = getattr(k, name, None)
+        if not (_finite(v) and float(v) > 0 and float(v).is_integer()):
+            raise FrameError(f"{name} must be a positive whole number of pixels, got {v!r}", field=f"{where}.{name}")
+    for name in ("fx", "fy"):
+        v = getattr(k, name, None)
+        if not (_finite(v) and float(v) > 0):
+            raise FrameError(f"focal length {name} must be finite and > 0 pixels, got {v!r}", field=f"{where}.{name}")
+    for name in ("cx", "cy"):
+        v = getattr(k, name, None)
+        if not _finite(v):
+            raise FrameError(f"principal point {name} must be finite, got {v!r}", field=f"{where}.{name}")
 
 
 def wrap_angle(angle: float) -> float:
@@ -63,6 +90,9 @@ class CameraIntrinsics:
     fy: float
     cx: float
     cy: float
+
+    def __post_init__(self) -> None:
+        check_intrinsics(self)
 
     @staticmethod
     def from_hfov(width: int, height: int, hfov_deg: float) -> CameraIntrinsics:
@@ -104,9 +134,16 @@ def camera_pose_from_base(base: Pose2D, height: float, tilt: float = 0.0) -> np.
 class Frame:
     """One RGB-D observation.
 
-    rgb: (H, W, 3) uint8; depth: (H, W) float32 metres along the optical axis (0 or NaN =
-    no return); instances: (H, W) int32 ground-truth instance ids (simulator only, -1 = none;
-    only the oracle detector may read it). T_world_cam: (4, 4) float64 camera-to-world.
+    rgb: (H, W, 3) uint8 (or float in [0, 1]); depth: (H, W) float32 metres along the optical
+    axis (0 or NaN = no return); instances: (H, W) int32 ground-truth instance ids (simulator
+    only, -1 = none; only the oracle detector may read it). T_world_cam: (4, 4) float64
+    camera-to-world.
+
+    Checked where it enters (``FrameError`` naming the field, see ``check_frame``): rgb (H, W, 3)
+    of the depth's (H, W), uint8 or finite float in [0, 1]; intrinsics (``check_intrinsics``);
+    T_world_cam (4, 4) finite; base pose and stamp finite. A field given as None is left to the
+    consumer that needs it (the grid names a missing depth or pose); depth values are not checked
+    here (NaN / inf / <= 0 mean "no return" and are masked by the consumers, counted).
     """
 
     rgb: np.ndarray
@@ -119,8 +156,41 @@ class Frame:
     seq: int = 0
 
     def __post_init__(self) -> None:
+        check_frame(self)
         for name in ("rgb", "depth", "T_world_cam", "instances"):
             freeze(getattr(self, name))
+
+
+def check_frame(frame: Frame, where: str = "frame") -> None:
+    """Raise ``FrameError`` naming the field of the first thing wrong with ``frame`` (see ``Frame``)."""
+    depth = None if frame.depth is None else np.asarray(frame.depth)
+    if frame.rgb is not None:
+        rgb = np.asarray(frame.rgb)
+        if rgb.ndim != 3 or rgb.shape[2] != 3:
+            raise FrameError(f"rgb has shape {rgb.shape}, expected (H, W, 3)", field=f"{where}.rgb")
+        if depth is not None and depth.ndim == 2 and rgb.shape[:2] != depth.shape:
+            raise FrameError(f"rgb is {rgb.shape[:2]} pixels but depth is {depth.shape}: they must match",
+                             field=f"{where}.rgb")
+        if rgb.dtype != np.uint8:
+            if not np.issubdtype(rgb.dtype, np.floating):
+                raise FrameError(f"rgb has dtype {rgb.dtype}, expected uint8 (or float in [0, 1])",
+                                 field=f"{where}.rgb")
+            if rgb.size and not (np.all(np.isfinite(rgb)) and float(rgb.min()) >= 0.0 and float(rgb.max()) <= 1.0):
+                raise FrameError("float rgb must be finite and in [0, 1]", field=f"{where}.rgb")
+    if frame.intrinsics is not None:
+        check_intrinsics(frame.intrinsics, f"{where}.intrinsics")
+    if frame.T_world_cam is not None:
+        T = np.asarray(frame.T_world_cam)
+        if T.shape != (4, 4) or not np.issubdtype(T.dtype, np.number) or not np.all(np.isfinite(T)):
+            raise FrameError(f"T_world_cam must be a finite (4, 4) matrix, got shape {T.shape}",
+                             field=f"{where}.T_world_cam")
+    bp = frame.base_pose
+    if bp is not None:
+        for name in ("x", "y", "yaw"):
+            if not _finite(getattr(bp, name, None)):
+                raise FrameError(f"base pose {name} is not finite: {bp}", field=f"{where}.base_pose.{name}")
+    if not _finite(frame.stamp):
+        raise FrameError(f"stamp must be a finite time in seconds, got {frame.stamp!r}", field=f"{where}.stamp")
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
 
 
 class OccupancyConfig(BaseModel):
@@ -13,6 +13,14 @@ class OccupancyConfig(BaseModel):
     resolution: float = Field(0.05, gt=0.0, description="cell side (m)")
     initial_size_m: float = Field(12.0, gt=0.0, description="side of the first grid, centred on the robot")
     grow_padding_m: float = Field(4.0, ge=0.0, description="extra margin added when the grid grows")
+    max_extent_m: float = Field(
+        200.0,
+        gt=0.0,
+        le=2000.0,
+        description="the grid never grows wider or taller than this (m): a frame that would need more "
+        "(a pose far off, a localisation glitch) is refused (FrameError) instead of allocating "
+        "(200 m at 0.05 m is 4000 x 4000 cells, about 150 MB of layers)",
+    )
     depth_stride: int = Field(4, ge=1, description="use every n-th depth pixel in both directions")
     min_depth: float = Field(0.1, ge=0.0, description="closer depth is ignored (m)")
     max_depth: float = Field(5.0, gt=0.0, description="mapping range along the optical axis (m)")
@@ -61,6 +69,14 @@ class OccupancyConfig(BaseModel):
     logodds_clamp: int = Field(12, ge=1, le=100)
     mark_footprint_free: bool = Field(True, description="the cells under the robot are free")
 
+    @field_validator("max_extent_m")
+    @classmethod
+    def _extent_holds_the_first_grid(cls, v: float, info: ValidationInfo) -> float:
+        initial = info.data.get("initial_size_m")
+        if initial is not None and v < initial:
+            raise ValueError(f"max_extent_m must be at least initial_size_m ({initial:g} m)")
+        return v
+
 
 class FrontierConfig(BaseModel):
     """mapping.frontiers.*: frontier extraction and tracking."""
@@ -77,6 +93,27 @@ class FrontierConfig(BaseModel):
     robot_search_m: float = Field(0.5, ge=0.0, description="search radius for a free cell near the robot")
 
 
+class PoseGateConfig(BaseModel):
+    """mapping.pose_gate.*: a base pose may not move faster than the robot can between frames."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    max_speed_mps: float = Field(
+        2.0,
+        gt=0.0,
+        le=100.0,
+        description="fastest the base pose may move between frames (m/s); a frame whose pose moved farther "
+        "than this times the elapsed time plus margin_m is a localisation glitch and is dropped "
+        "(4x the simulator's and the rovers' 0.5 m/s)",
+    )
+    margin_m: float = Field(
+        1.0,
+        ge=0.0,
+        le=100.0,
+        description="jump allowed on top of the speed bound (m): odometry noise, stamps that lag the pose",
+    )
+
+
 class MappingConfig(BaseModel):
     """mapping.* settings."""
 
@@ -84,3 +121,4 @@ class MappingConfig(BaseModel):
 
     occupancy: OccupancyConfig = Field(default_factory=OccupancyConfig)
     frontiers: FrontierConfig = Field(default_factory=FrontierConfig)
+    pose_gate: PoseGateConfig = Field(default_factory=PoseGateConfig)

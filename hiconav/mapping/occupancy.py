@@ -6,7 +6,9 @@ pseudo laser scan: per angular bin around the camera, the nearest obstacle range
 farthest observed range. The free-space fan (camera -> min(obstacle - margin, farthest)) is
 rasterised with cv2.fillPoly (ray clearing), obstacle cells get log-odds hits, and the
 obstacles are inflated by the robot radius with cv2.dilate. Only a window around the camera is
-touched per frame; the grid grows (re-allocated with padding) when the robot sees past its edge.
+touched per frame; the grid grows (re-allocated with padding) when the robot sees past its edge,
+never beyond ``max_extent_m`` a side: a frame that would need more (a pose kilometres off) is
+refused with a FrameError before anything is allocated.
 
 Two details keep free cells honest (>= 99% navigable in the simulator's ground truth): a pixel
 that reads no depth although its ray would meet the floor within range means something closer
@@ -180,6 +182,7 @@ class OccupancyGrid(_OccupancyFields):
         self.version = 0
         self.stamp = 0.0
         self.n_invalid_total = 0
+        self.n_refused_total = 0  # frames refused because the grid would outgrow max_extent_m
         c = self.config
         self._inflate_cells = (c.robot_radius + c.inflation_margin) / self.resolution
         self._kernel = disk_kernel(self._inflate_cells)
@@ -190,15 +193,17 @@ class OccupancyGrid(_OccupancyFields):
 
     # ------------------------------------------------------------------ grid geometry
 
-    def _ensure_bounds(self, xmin: float, ymin: float, xmax: float, ymax: float) -> bool:
-        """Grow the grid so that it covers [xmin, xmax] x [ymin, ymax]; True if it grew."""
+    def _grown_bounds(self, xmin: float, ymin: float, xmax: float, ymax: float
+                      ) -> tuple[float, float, int, int] | None:
+        """(origin x, origin y, width, height in cells) of the grid that covers [xmin, xmax] x
+        [ymin, ymax]; None when the grid already does."""
         res = self.resolution
         h, w = self.state.shape
         if h > 0:
             gx0, gy0 = self.origin
             gx1, gy1 = gx0 + w * res, gy0 + h * res
             if xmin >= gx0 and ymin >= gy0 and xmax <= gx1 and ymax <= gy1:
-                return False
+                return None
             pad = self.config.grow_padding_m
             nx0 = min(gx0, xmin - pad) if xmin < gx0 else gx0
             ny0 = min(gy0, ymin - pad) if ymin < gy0 else gy0
@@ -212,8 +217,32 @@ class OccupancyGrid(_OccupancyFields):
         # keep the origin on the global lattice (multiples of res) so that cells never shift
         ox = math.floor(nx0 / res + 1e-9) * res
         oy = math.floor(ny0 / res + 1e-9) * res
-        nw = int(math.ceil((nx1 - ox) / res - 1e-9))
-        nh = int(math.ceil((ny1 - oy) / res - 1e-9))
+        # in metres first: a far pose must not overflow the cell count before the extent check
+        width_m, height_m = nx1 - ox, ny1 - oy
+        limit = self.config.max_extent_m
+        if not (width_m <= limit + 1e-6 and height_m <= limit + 1e-6):
+            self.n_refused_total += 1
+            raise FrameError(
+                f"the grid would grow to {width_m:.4g} m x {height_m:.4g} m to reach the camera at "
+                f"({(xmin + xmax) / 2.0:.4g}, {(ymin + ymax) / 2.0:.4g}), beyond mapping.occupancy.max_extent_m = "
+                f"{limit:g} m: a pose this far from the map is a localisation jump; frame refused, map unchanged",
+                field="frame.T_world_cam",
+            )
+        nw = int(math.ceil(width_m / res - 1e-9))
+        nh = int(math.ceil(height_m / res - 1e-9))
+        return ox, oy, nw, nh
+
+    def _ensure_bounds(self, xmin: float, ymin: float, xmax: float, ymax: float) -> bool:
+        """Grow the grid so that it covers [xmin, xmax] x [ymin, ymax]; True if it grew.
+
+        Raises ``FrameError`` (nothing allocated or changed) when the grid would outgrow
+        ``config.max_extent_m``."""
+        bounds = self._grown_bounds(xmin, ymin, xmax, ymax)
+        if bounds is None:
+            return False
+        ox, oy, nw, nh = bounds
+        res = self.resolution
+        h, w = self.state.shape
         logodds = np.zeros((nh, nw), dtype=np.int8)
         explored = np.zeros((nh, nw), dtype=bool)
         top = np.zeros((nh, nw), dtype=np.float32)
@@ -255,6 +284,11 @@ class OccupancyGrid(_OccupancyFields):
         stride = c.depth_stride
         T = np.asarray(frame.T_world_cam, dtype=np.float64)
         cam_xy = T[:2, 3].copy()
+        # window touched by this frame: the mapping range around the camera; a frame that would make
+        # the grid outgrow its bound is refused here, before anything changes
+        reach = c.max_depth + 2 * res
+        window = (cam_xy[0] - reach, cam_xy[1] - reach, cam_xy[0] + reach, cam_xy[1] + reach)
+        self._grown_bounds(*window)
         # classify the strided pixels: valid returns, "far" returns (at the sensor's clip depth:
         # free space, no obstacle) and invalid ones (NaN, inf, <= 0, out of range: ignored, counted)
         far_depth = min(c.max_depth, c.sensor_max_depth) - 1e-3
@@ -282,9 +316,7 @@ class OccupancyGrid(_OccupancyFields):
         is_obs = (rel_z >= c.obstacle_min_height) & (rel_z <= c.obstacle_max_height)
         obs_x, obs_y, obs_z = px[is_obs], py[is_obs], rel_z[is_obs]
 
-        # window touched by this frame: the mapping range around the camera
-        reach = c.max_depth + 2 * res
-        grew = self._ensure_bounds(cam_xy[0] - reach, cam_xy[1] - reach, cam_xy[0] + reach, cam_xy[1] + reach)
+        grew = self._ensure_bounds(*window)
         h, w = self.state.shape
         r0 = max(0, int(math.floor((cam_xy[1] - reach - self.origin[1]) / res)))
         c0 = max(0, int(math.floor((cam_xy[0] - reach - self.origin[0]) / res)))

@@ -35,6 +35,13 @@ log = logging.getLogger(__name__)
 
 
 
+def _finite_pose(pose: Pose2D) -> bool:
+    try:
+        return all(math.isfinite(float(v)) for v in (pose.x, pose.y, pose.yaw))
+    except (AttributeError, TypeError, ValueError):
+        return False
+
+
 def squeeze_mask(grid: GridLike) -> np.ndarray:
     """(H, W) bool: the lethal layer shrunk by one cell (4-neighbour erosion), occupied cells kept.
 
@@ -99,7 +106,8 @@ class Navigator:
     """Follows A* paths to a Goal on an occupancy grid (OccupancyGrid or GridSnapshot).
 
     Attributes: goal (Goal | None), reached (bool), status ("idle", "following", "reached",
-    "no_path", "recovering", "stuck": ``max_recoveries`` recoveries for the goal in one spot),
+    "no_path", "recovering", "stuck": ``max_recoveries`` recoveries for the goal in one spot,
+    "bad_pose": the last pose given was not finite, no motion commanded),
     path_xy ((N, 2) world waypoints of the smoothed path or None),
     n_plans, n_recoveries.
     """
@@ -387,7 +395,13 @@ class Navigator:
 
     # ------------------------------------------------------------------ discrete control
     def step(self, grid: GridLike, pose: Pose2D) -> DiscreteAction:
-        """The next discrete action toward the goal (STOP when reached or when there is no path)."""
+        """The next discrete action toward the goal (STOP when reached or when there is no path).
+
+        A non-finite pose gives STOP (status "bad_pose") and changes nothing: no motion from a pose
+        the robot does not know."""
+        if not _finite_pose(pose):
+            self.status = "bad_pose"
+            return DiscreteAction.STOP
         cfg = self.config
         self._ticks_since_plan += 1
         self._record_trail(pose)
@@ -528,7 +542,12 @@ class Navigator:
     def step_velocity(
         self, grid: GridLike, pose: Pose2D, dt: float = 0.1, stamp: float = 0.0
     ) -> VelocityCommand:
-        """The next velocity command toward the goal (zero when reached or when there is no path)."""
+        """The next velocity command toward the goal (zero when reached or when there is no path).
+
+        A non-finite pose gives the zero command (status "bad_pose") and changes nothing."""
+        if not _finite_pose(pose):
+            self.status = "bad_pose"
+            return VelocityCommand.zero(stamp)
         cfg = self.config
         self._ticks_since_plan += 1
         self._elapsed += dt

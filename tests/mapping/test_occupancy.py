@@ -256,3 +256,32 @@ def test_lethal_layer_is_the_robot_radius_alone_and_travels_with_snapshots():
     snap = grid.snapshot()
     np.testing.assert_array_equal(snap.lethal, grid.lethal)
     assert not snap.lethal.flags.writeable
+
+
+@pytest.mark.parametrize("jump_m", [1e6, 400.0])
+def test_a_pose_far_off_the_map_is_refused_instead_of_growing_the_grid(jump_m):
+    """A localisation jump must not make the grid allocate (1e6 m at 0.05 m: 364 TiB)."""
+    grid = OccupancyGrid()
+    grid.integrate(render_boxes(Pose2D(0, 0, 0), [WALL]))
+    before = (grid.state.copy(), grid.origin.copy(), grid.version, grid.n_invalid_total)
+    with pytest.raises(FrameError, match="max_extent_m") as e:
+        grid.integrate(render_boxes(Pose2D(jump_m, 0, 0), []))
+    assert e.value.field == "frame.T_world_cam"
+    assert grid.n_refused_total == 1
+    np.testing.assert_array_equal(grid.state, before[0])
+    np.testing.assert_array_equal(grid.origin, before[1])
+    assert (grid.version, grid.n_invalid_total) == before[2:]
+
+
+def test_the_grid_grows_up_to_its_max_extent():
+    grid = OccupancyGrid(OccupancyConfig(initial_size_m=12.0, grow_padding_m=4.0, max_extent_m=40.0))
+    grid.integrate(render_boxes(Pose2D(0, 0, 0), [WALL]))
+    grid.integrate(render_boxes(Pose2D(20.0, 0, 0), []))  # x from -6 m to 20 + 5.1 + 4 m: 35.1 m wide
+    assert grid.shape[1] * grid.resolution <= 40.0
+    with pytest.raises(FrameError, match="max_extent_m"):
+        grid.integrate(render_boxes(Pose2D(40.0, 0, 0), []))
+
+
+def test_max_extent_below_the_first_grid_is_a_config_error():
+    with pytest.raises(ValueError, match="initial_size_m"):
+        OccupancyConfig(initial_size_m=12.0, max_extent_m=10.0)

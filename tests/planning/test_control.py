@@ -432,3 +432,26 @@ def test_a_robot_circling_near_its_goal_settles_there_but_not_far_from_it():
     assert rock(Navigator(), goal, 0.16, 60) <= NavigatorConfig().settle_steps + 2
     assert rock(Navigator(), goal, 0.5, 60) is None  # 0.5 m off: not there
     assert rock(Navigator(NavigatorConfig(settle_steps=1000)), goal, 0.16, 60) is None
+
+
+@pytest.mark.parametrize("pose", [Pose2D(1.0, 1.0, math.nan), Pose2D(math.nan, 1.0, 0.0), Pose2D(1.0, math.inf, 0.0)])
+def test_a_non_finite_pose_gives_stop_and_no_turn(pose):
+    nav = Navigator()
+    nav.set_goal(Goal(3.5, 1.0, tolerance=0.2))
+    assert nav.step(snapshot(open_room()), pose) == DiscreteAction.STOP
+    assert nav.status == "bad_pose" and not nav.reached and nav.n_plans == 0
+
+
+def test_a_non_finite_pose_gives_the_zero_velocity():
+    nav = Navigator()
+    nav.set_goal(Goal(3.5, 1.0, tolerance=0.2))
+    cmd = nav.step_velocity(snapshot(open_room()), Pose2D(1.0, 1.0, math.nan), 0.1, 2.0)
+    assert (cmd.v, cmd.omega, cmd.stamp) == (0.0, 0.0, 2.0) and nav.status == "bad_pose"
+
+
+def test_the_navigator_goes_on_after_a_non_finite_pose():
+    nav = Navigator()
+    nav.set_goal(Goal(3.5, 1.0, tolerance=0.2))
+    grid = snapshot(open_room())
+    nav.step(grid, Pose2D(1.0, 1.0, math.nan))
+    assert nav.step(grid, Pose2D(1.0, 1.0, 0.0)) == DiscreteAction.MOVE_FORWARD
