@@ -96,7 +96,7 @@ class FrontierConfig(BaseModel):
 class PoseGateConfig(BaseModel):
     """mapping.pose_gate.*: a base pose may not move faster than the robot can between frames."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     max_speed_mps: float = Field(
         2.0,

@@ -155,10 +155,19 @@ def test_eval_runner_entry_point_returns_an_episode_record(shared_data, embedder
 
 def test_stepped_offline_reasoning_takes_no_measured_wall_time(house, episodes, embedder):
     """Same seed, same metrics needs virtual delays that do not depend on the machine's load: the
-    offline reasoner's measured wall time must not become its stepped latency."""
+    offline reasoner's measured wall time must not become its stepped latency; every call takes
+    the modelled latency (reasoning.latency_s +- reasoning.latency_jitter_s, seeded) instead."""
+    from hiconav.mission import LatencyModel
+
     parts = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder)
     assert parts.reasoner_name == "offline"
-    assert parts.reasoning.latency_s == 0.0 and parts.reasoning.parse_latency_s == 0.0
+    assert isinstance(parts.reasoning.latency_s, LatencyModel)
+    again = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder)
+    assert [float(parts.reasoning.latency_s) for _ in range(5)] == [float(again.reasoning.latency_s) for _ in range(5)]
+    assert 1.5 <= float(parts.reasoning.parse_latency_s) <= 2.5
+    instant = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder,
+                            overrides={"reasoning.latency_s": 0.0})
+    assert float(instant.reasoning.latency_s) == 0.0
     configured = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder,
                                overrides={"mission.vlm_latency_s": 2.0})
     assert configured.reasoning.latency_s == 2.0

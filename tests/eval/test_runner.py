@@ -68,7 +68,9 @@ def test_each_episode_seed_is_the_same_for_every_preset(tmp_path) -> None:
     for r in records:
         seeds.setdefault(r.episode_id, set()).add(r.seed)
     assert all(len(s) == 1 for s in seeds.values())
-    assert len(summary["presets"]) == 7 and set(summary["ablations"]) == set(summary["presets"]) - {"full"}
+    from hiconav.eval.presets import PRESETS
+
+    assert len(summary["presets"]) == len(PRESETS) == 9 and set(summary["ablations"]) == set(summary["presets"]) - {"full"}
 
 
 def test_bad_input_and_crashes_are_recorded_and_never_abort_the_run(tmp_path) -> None:

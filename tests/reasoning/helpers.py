@@ -24,6 +24,9 @@ class FakeObject:
     n_obs: int = 3
     anchor_ids: tuple[int, ...] = ()
     center: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    # every object of the fixture stands in one 0.2 m box: the task's "mug next to the sink" holds
+    box_min: np.ndarray = field(default_factory=lambda: np.full(3, -0.1))
+    box_max: np.ndarray = field(default_factory=lambda: np.full(3, 0.1))
 
 
 @dataclass(frozen=True)
