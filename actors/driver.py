@@ -74,7 +74,9 @@ class DriverNode(Node):
         self.latest_wins(CommandMsg)
 
     def start(self, now: float) -> None:
-        self._pending_frame = self.sim.reset(self.start_pose)
+        self._reobserve = False
+        self.last_bad_frame = ""
+        self._pending_frame = self._frame(lambda: self.sim.reset(self.start_pose))
         self._record()
 
     def _record(self) -> None:
@@ -107,21 +109,40 @@ class DriverNode(Node):
     def _drop(self, slot: str) -> None:
         self.stats.dropped[slot] = self.stats.dropped.get(slot, 0) + 1
 
+    def _frame(self, make: Any) -> Any:
+        """``make()`` (a frame from the robot), or None when the robot's frame is invalid (a NaN
+        pose, a broken image: ``FrameError``): the frame is dropped and counted, never the
+        mission, and the next tick observes again (a lockstep robot streams nothing by itself)."""
+        from hiconav.errors import FrameError
+
+        try:
+            return make()
+        except FrameError as exc:
+            self._drop("bad_frame")
+            self.last_bad_frame = str(exc)
+            self._reobserve = True
+            return None
+
     def tick(self, now: float) -> None:
         t0 = time.perf_counter()
         if self.ended is None and self._check_health(now):
             if self.take(CommandMsg) is not None:  # the driver streams zero while paused
                 self._drop("paused")
             return
+        if getattr(self, "_reobserve", False) and self._pending_frame is None and self.ended is None:
+            self._reobserve = False
+            self._pending_frame = self._frame(self.sim.observe)
         if self._pending_frame is not None:
             self.emit(self.frame_to, FrameMsg(self._pending_frame, int(self.sim.steps)))
             self._pending_frame = None
             self._frame_sent_at = now
         cmd = self.take(CommandMsg)
         if cmd is None and self.stream and self.ended is None and now - self._frame_sent_at >= 0.9 * self.period:
-            self.emit(self.frame_to, FrameMsg(self.sim.observe(), int(self.sim.steps)))
+            streamed = self._frame(self.sim.observe)
+            if streamed is not None:
+                self.emit(self.frame_to, FrameMsg(streamed, int(self.sim.steps)))
+                self.streamed += 1
             self._frame_sent_at = now
-            self.streamed += 1
             return
         if cmd is None or self.ended is not None:
             return
@@ -132,20 +153,22 @@ class DriverNode(Node):
         if cmd.action is not None:
             self.last_command = cmd.action
             self.actions.append(cmd.action.value)
-            frame = self.sim.step(cmd.action)
+            frame = self._frame(lambda: self.sim.step(cmd.action))
             self._record()
             if cmd.action == DiscreteAction.STOP:
                 self._end("stop", now)
                 return
         elif cmd.velocity is not None:
             self.last_command = cmd.velocity
-            frame = self.sim.step_velocity(cmd.velocity, self.velocity_dt)
+            frame = self._frame(lambda: self.sim.step_velocity(cmd.velocity, self.velocity_dt))
             self._record()
         else:
             return
         if self.sim.steps >= self.max_steps:
             self._end("max_steps", now)
             return
+        if frame is None:
+            return  # dropped: observed again next tick
         self.emit(self.frame_to, FrameMsg(frame, int(self.sim.steps)))
         self._frame_sent_at = now + (time.perf_counter() - t0)  # the step took real time
 
