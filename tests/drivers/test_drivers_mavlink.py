@@ -249,7 +249,9 @@ def test_stale_pose_stops_motion(make_link):
 
 
 def test_geofence_breach_stops_and_latches(make_link):
-    profile = test_profile(geofence={"kind": "box", "xy_min": [-1.0, -1.0], "xy_max": [1.0, 1.0]})
+    # the robot is teleported out and back: a jump the pose-jump check (not under test here) allows
+    profile = test_profile(geofence={"kind": "box", "xy_min": [-1.0, -1.0], "xy_max": [1.0, 1.0]},
+                           failsafe={"pose_jump_margin_m": 5.0})
     vehicle, driver, _ = make_link(profile=profile)
     driver.send(VelocityCommand(0.5, 0.0))
     assert wait_until(lambda: vehicle.state().v > 0.4, 1.0)
