@@ -21,6 +21,7 @@ def vehicle(
     system_id: int = typer.Option(1, "--system-id", min=1, max=255),
     pose_hz: float = typer.Option(25.0, "--pose-hz", min=1.0, max=200.0),
     setpoint_timeout: float = typer.Option(0.4, "--setpoint-timeout", min=0.05, help="s without a setpoint before the vehicle stops."),
+    gcs_timeout: float = typer.Option(3.0, "--gcs-timeout", min=0.1, help="s without a GCS heartbeat before the vehicle stops."),
     max_linear: float = typer.Option(1.0, "--max-linear", min=0.01),
     max_angular: float = typer.Option(2.0, "--max-angular", min=0.01),
     radius: float = typer.Option(0.18, "--radius", min=0.01, help="robot radius for collisions (m)."),
@@ -53,7 +54,7 @@ def vehicle(
         pose = Pose2D(x, y, yaw)
     key = _signing_key(signing_key, signing_key_file)
     config = VehicleConfig(autopilot=autopilot, system_id=system_id, start=pose, pose_hz=pose_hz,
-                           setpoint_timeout_s=setpoint_timeout, max_linear=max_linear, max_angular=max_angular,
+                           setpoint_timeout_s=setpoint_timeout, gcs_timeout_s=gcs_timeout, max_linear=max_linear, max_angular=max_angular,
                            robot_radius=radius, refuse_modes=frozenset(m.upper() for m in refuse_mode),
                            refuse_arm=refuse_arm, signing_key=key)
     try:
@@ -78,12 +79,13 @@ def vehicle(
 
 def _signing_key(text: str | None, path: str | None) -> bytes | None:
     """The vehicle's signing key from --signing-key or --signing-key-file (as a profile reads it)."""
-    from hiconav.drivers.profiles import MavlinkProfile
+    from hiconav.drivers.profiles import MavlinkProfile, parse_signing_key
 
     if text is not None and path is not None:
         raise ConfigError("give --signing-key or --signing-key-file, not both", field="signing_key")
-    try:
-        return MavlinkProfile(signing_key=text, signing_key_file=path).secret_key()
-    except ValueError as exc:  # pydantic's ValidationError is a ValueError
-        raise ConfigError(f"--signing-key: {exc.errors()[0]['msg'] if hasattr(exc, 'errors') else exc}",
-                          field="signing_key") from None
+    if text is not None:
+        try:
+            return parse_signing_key(text, "--signing-key")
+        except ValueError as exc:
+            raise ConfigError(str(exc), field="signing_key") from None
+    return MavlinkProfile(signing_key_file=path).secret_key() if path is not None else None
