@@ -31,7 +31,8 @@ def test_mission_through_mavproxy(tmp_path):
     vehicle = SimulatedVehicle(f"udpout:127.0.0.1:{master}", VehicleConfig()).start()
     # link health is not under test while MAVProxy relays on a busy machine: a long link timeout
     driver = MavlinkDriver(test_profile(mavlink={"heartbeat_wait_s": READY_S, "ack_timeout_s": 10.0},
-                                        failsafe={"link_timeout_s": 5.0, "pose_timeout_s": 5.0}),
+                                        failsafe={"link_timeout_s": 5.0, "heartbeat_timeout_s": 10.0,
+                                                  "pose_timeout_s": 5.0}),
                            url=f"udpin:127.0.0.1:{out}", handle_signals=False)
     try:
         driver.connect()
