@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 import ray
 
 from hiconav.eval.config import EvalConfig
@@ -23,6 +24,7 @@ def rows(path: Path) -> list[dict]:
     return out
 
 
+@pytest.mark.timeout(1200)  # ~30 s on 2 idle cores; 285 s beside four busy loops
 def test_ray_and_local_backends_write_identical_episodes(tmp_path, shared_data) -> None:
     specs = generate_for_house("procthor:val/3", 2, seed=0)  # as `hiconav eval ... --limit 2`
     assert len(specs) == 2 and all(s.error is None for s in specs)
