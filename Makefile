@@ -18,6 +18,9 @@ $(STAMP): pyproject.toml setup.py
 	# torch first, pinned: the CPU build on disk; a later unpinned resolve would pull a CUDA build
 	$(BIN)/python -m pip install --quiet "torch==2.13.0"
 	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	# MAVProxy for tests/drivers/test_drivers_mavproxy.py, without its dependencies: they pull
+	# opencv-python, which clashes with our opencv-python-headless (pyserial is all it needs here)
+	$(BIN)/python -m pip install --quiet --no-deps MAVProxy pyserial
 	touch $(STAMP)
 
 demo: $(STAMP)

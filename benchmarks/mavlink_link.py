@@ -1,5 +1,6 @@
 """Benchmark of the MAVLink link on 127.0.0.1: setpoint rate, command-to-motion latency, and the
-time from a cut link to (a) the vehicle stopping and (b) the driver reporting link loss.
+time from a cut link to (a) the vehicle stopping, (b) the driver reporting link loss and (c) the
+driver's first zero setpoint (measured from the last message the driver heard).
 Prints the figures and ends with one JSON line."""
 from __future__ import annotations
 
@@ -42,16 +43,20 @@ def trial(n_latency: int = 10) -> dict:
         driver.send(VelocityCommand(0.5, 0.0))
         wait_until(lambda: vehicle.state().v > 0.0, 2.0)
         t_cut = relay.cut()
-        stop_at = lost_at = None
+        stop_at = lost_at = zero_at = None
         end = t_cut + 3.0
-        while time.monotonic() < end and (stop_at is None or lost_at is None):
+        while time.monotonic() < end and (stop_at is None or lost_at is None or zero_at is None):
             driver.send(VelocityCommand(0.5, 0.0))
             now = time.monotonic()
             if stop_at is None and vehicle.state().v == 0.0:
                 stop_at = now
             if lost_at is None and driver.health().failsafe == FailsafeState.LINK_LOST:
                 lost_at = now
+            if zero_at is None and driver.last_sent == (0.0, 0.0):
+                zero_at = now
             time.sleep(0.002)
+        last_heard = driver._last_message  # driver clock = time.monotonic
+        out["last_message_to_driver_zero_s"] = None if zero_at is None or last_heard is None else zero_at - last_heard
         out["cut_to_vehicle_stop_s"] = None if stop_at is None else stop_at - t_cut
         out["cut_to_driver_link_lost_s"] = None if lost_at is None else lost_at - t_cut
     finally:
@@ -70,13 +75,16 @@ def main() -> None:
     print(f"setpoint rate at the vehicle: {min(rate):.1f}-{max(rate):.1f} Hz (target 20)")
     print(f"command -> vehicle moving: median {statistics.median(lat)*1e3:.0f} ms, max {max(lat)*1e3:.0f} ms")
     print(f"link cut -> vehicle stopped: {', '.join(f'{s:.3f}' for s in stop)} s (limit 0.5; vehicle timeout 0.4)")
-    print(f"link cut -> driver LINK_LOST: {', '.join(f'{s:.3f}' for s in lost)} s (timeout 0.5)")
+    zero = [t["last_message_to_driver_zero_s"] for t in trials]
+    print(f"link cut -> driver LINK_LOST: {', '.join(f'{s:.3f}' for s in lost)} s (timeout 0.4)")
+    print(f"last message -> driver's first zero setpoint: {', '.join(f'{s:.3f}' for s in zero)} s (limit 0.5)")
     print(json.dumps({"bench": "mavlink_link", "trials": len(trials),
                       "setpoint_hz_min": round(min(rate), 1),
                       "command_to_motion_ms_median": round(statistics.median(lat) * 1e3, 1),
                       "command_to_motion_ms_max": round(max(lat) * 1e3, 1),
                       "cut_to_vehicle_stop_s_max": round(max(stop), 3),
-                      "cut_to_driver_link_lost_s_max": round(max(lost), 3)}))
+                      "cut_to_driver_link_lost_s_max": round(max(lost), 3),
+                      "last_message_to_driver_zero_s_max": round(max(zero), 3)}))
 
 
 if __name__ == "__main__":

@@ -60,8 +60,9 @@ class FailsafeState:
     POSE_STALE = "pose_stale"  # newest pose older than pose_timeout_s (or none yet)
     GEOFENCE = "geofence"  # the robot left the geofence (latched until resume())
     MODE_LOST = "mode_lost"  # the vehicle left GUIDED/OFFBOARD or disarmed (latched)
+    POSE_JUMP = "pose_jump"  # a position farther than the vehicle can move was rejected (latched)
     CLOSED = "closed"
-    LATCHED = frozenset({LINK_LOST, HEARTBEAT_LOST, GEOFENCE, MODE_LOST})
+    LATCHED = frozenset({LINK_LOST, HEARTBEAT_LOST, GEOFENCE, MODE_LOST, POSE_JUMP})
 
 
 @dataclass(frozen=True)

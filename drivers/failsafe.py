@@ -1,10 +1,11 @@
 """Failsafe logic for real-robot drivers: link and heartbeat loss, stale pose, geofence, mode loss,
 and a zero setpoint on Ctrl-C / exit.
 
-``FailsafeMonitor`` is pure and clock-free: the driver passes the times it measured, and gets back
-the state and the velocity it may send. It never commands motion of its own; the only output it
+``FailsafeMonitor`` is pure and clock-free: the driver passes the times it measured (and the
+newest position it rejected as a jump beyond what the vehicle can move), and gets back the state
+and the velocity it may send. It never commands motion of its own; the only output it
 can produce is "less motion" (zero, or a clamped forward speed). A latched failsafe (link,
-heartbeat, geofence, mode) holds the robot still and pauses the mission until ``resume()`` finds
+heartbeat, geofence, mode, pose jump) holds the robot still and pauses the mission until ``resume()`` finds
 every condition healthy again. ``install_stop_handlers`` is the one piece with side effects: it
 hooks SIGINT/SIGTERM and atexit so that a zero setpoint goes out before the process ends.
 """
@@ -108,8 +109,8 @@ class FailsafeMonitor:
         return self._latched
 
     def _conditions(self, now: float, last_message: float | None, last_heartbeat: float | None,
-                    pose_stamp: float | None, pose: Pose2D | None,
-                    engaged: bool | None) -> list[tuple[str, str]]:
+                    pose_stamp: float | None, pose: Pose2D | None, engaged: bool | None,
+                    pose_jump: tuple[float, str] | None = None) -> list[tuple[str, str]]:
         c = self.config
         found: list[tuple[str, str]] = []
         if last_message is None or now - last_message > c.link_timeout_s:
@@ -121,6 +122,8 @@ class FailsafeMonitor:
             found.append((_FS.HEARTBEAT_LOST, f"no HEARTBEAT (last {age}; limit {c.heartbeat_timeout_s} s)"))
         if engaged is False:
             found.append((_FS.MODE_LOST, "the vehicle left the guided mode or disarmed"))
+        if pose_jump is not None and now - pose_jump[0] <= c.pose_timeout_s:
+            found.append((_FS.POSE_JUMP, pose_jump[1]))
         if pose is not None and self.geofence is not None and not self.geofence.contains(pose.x, pose.y):
             found.append((_FS.GEOFENCE, f"robot at ({pose.x:.2f}, {pose.y:.2f}) is outside the geofence"))
         if pose_stamp is None or now - pose_stamp > c.pose_timeout_s:
@@ -129,14 +132,17 @@ class FailsafeMonitor:
         return found
 
     def evaluate(self, now: float, *, last_message: float | None, last_heartbeat: float | None,
-                 pose_stamp: float | None, pose: Pose2D | None, engaged: bool | None) -> FailsafeStatus:
-        found = self._conditions(now, last_message, last_heartbeat, pose_stamp, pose, engaged)
+                 pose_stamp: float | None, pose: Pose2D | None, engaged: bool | None,
+                 pose_jump: tuple[float, str] | None = None) -> FailsafeStatus:
+        found = self._conditions(now, last_message, last_heartbeat, pose_stamp, pose, engaged, pose_jump)
         link_ok = not any(s == _FS.LINK_LOST for s, _ in found)
         pose_age = math.inf if pose_stamp is None else max(0.0, now - pose_stamp)
         if self._latched is None:
             for state, reason in found:
-                # never heard the vehicle yet: not a loss (connect() is still waiting), no latch
-                recoverable = (state in (_FS.LINK_LOST, _FS.HEARTBEAT_LOST) and last_message is None) or (
+                # never heard the vehicle (or its heartbeat) yet: not a loss (connect() is still
+                # waiting), no latch
+                recoverable = (state == _FS.LINK_LOST and last_message is None) or (
+                    state == _FS.HEARTBEAT_LOST and last_heartbeat is None) or (
                     state == _FS.LINK_LOST and self.config.resume_on_link_recovery)
                 if state in _FS.LATCHED and not recoverable:
                     self._latched = (state, reason)
@@ -149,13 +155,26 @@ class FailsafeMonitor:
         return FailsafeStatus(_FS.OK, "", False, link_ok, pose_age)
 
     def resume(self, now: float, *, last_message: float | None, last_heartbeat: float | None,
-               pose_stamp: float | None, pose: Pose2D | None, engaged: bool | None) -> tuple[bool, str]:
+               pose_stamp: float | None, pose: Pose2D | None, engaged: bool | None,
+               pose_jump: tuple[float, str] | None = None) -> tuple[bool, str]:
         """Clear a latched failsafe if every condition is healthy now; returns (ok, why not)."""
-        found = self._conditions(now, last_message, last_heartbeat, pose_stamp, pose, engaged)
+        found = self._conditions(now, last_message, last_heartbeat, pose_stamp, pose, engaged, pose_jump)
         if found:
             return False, found[0][1]
         self._latched = None
         return True, ""
+
+    def next_deadline(self, now: float, *, last_message: float | None, last_heartbeat: float | None,
+                      pose_stamp: float | None) -> float | None:
+        """The earliest time after ``now`` at which a timeout (link, heartbeat, pose) expires if
+        nothing more arrives, or None. The driver's sender wakes then, so that the zero setpoint
+        of a lost link goes out at ``link_timeout_s`` and not up to one setpoint period later."""
+        c = self.config
+        times = [t + limit for t, limit in ((last_message, c.link_timeout_s),
+                                            (last_heartbeat, c.heartbeat_timeout_s),
+                                            (pose_stamp, c.pose_timeout_s)) if t is not None]
+        future = [t for t in times if t > now]
+        return min(future) if future else None
 
     def gate(self, status: FailsafeStatus, pose: Pose2D | None, v: float, omega: float) -> tuple[float, float, str]:
         """The velocity that may be sent: zero unless ``status.ok``; forward motion is cut when it

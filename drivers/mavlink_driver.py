@@ -13,9 +13,21 @@ What it does:
 - switches mode (ArduPilot GUIDED by custom mode number, PX4 OFFBOARD by main/sub custom mode)
   and arms, waiting for COMMAND_ACK and the HEARTBEAT that confirms it; refusals raise
   ``CommandRefused`` with the MAV_RESULT name and the vehicle's last STATUSTEXT;
-- applies the failsafes of ``failsafe.FailsafeMonitor`` on every setpoint tick: link loss
-  (0.5 s by default) and heartbeat loss pause the mission and send zero; a stale pose stops
-  motion; a geofence breach stops and latches; motion that would leave the fence is cut.
+- applies the failsafes of ``failsafe.FailsafeMonitor`` on every setpoint tick (and wakes at
+  the moment a timeout expires): link loss (0.4 s by default, so the first zero setpoint goes out
+  within 0.5 s) and heartbeat loss pause the mission and send zero; a stale pose stops motion; a
+  geofence breach stops and latches; motion that would leave the fence is cut.
+
+Whom it trusts:
+- one vehicle: the system AND component id of ``mavlink.target_system`` / ``target_component``,
+  or (``target_system: 0``) the first vehicle heard, locked from then on with a logged warning;
+  messages from any other system or component are counted and dropped;
+- positions the vehicle can physically reach: one farther from the last accepted position than
+  ``failsafe.max_speed`` (default ``limits.max_linear``) x elapsed + ``pose_jump_margin_m`` is
+  rejected and latches the POSE_JUMP failsafe (zero setpoint, mission paused);
+- with ``mavlink.signing_key`` (or ``signing_key_file``): MAVLink 2 signing via pymavlink's
+  ``setup_signing``; everything we send is signed and unsigned or wrongly signed messages are
+  refused (a wrong key means no link: ``connect()`` reports the rejected messages).
 
 What it must not do: move on its own. The robot only moves while the navigator keeps sending
 commands (each command lasts ``failsafe.command_timeout_s``), so a failed or silent VLM leaves
@@ -25,6 +37,7 @@ the robot standing. RGB-D frames come from a separate ``FrameSource``.
 from __future__ import annotations
 
 import collections
+import logging
 import math
 import os
 import threading
@@ -61,6 +74,8 @@ __all__ = [
     "ned_to_enu",
     "quaternion_to_yaw",
 ]
+
+_log = logging.getLogger("hiconav.drivers.mavlink")
 
 DIALECT = "ardupilotmega"
 PX4_STREAM_S = 0.5  # s of setpoint streaming before asking PX4 for OFFBOARD
@@ -136,9 +151,17 @@ class MavlinkDriver:
         self._uninstall: Callable[[], None] | None = None
         self._t0 = clock()
         self._closed = False
-        # vehicle state (guarded by _lock)
-        self.target_system: int | None = self.profile.mavlink.target_system or None
-        self.target_component: int = self.profile.mavlink.target_component
+        # vehicle state (guarded by _lock). The vehicle is one system AND component: the
+        # profile's, or the first vehicle heard (locked then, with a warning)
+        cfg = self.profile.mavlink
+        self.target_system: int | None = cfg.target_system or None
+        self.target_component: int = cfg.target_component
+        self._component_locked = cfg.target_system != 0 and cfg.target_component != 0
+        self._secret_key: bytes | None = cfg.secret_key()  # ConfigError on a bad key, before any I/O
+        lim = self.profile.limits
+        self._max_speed = self.profile.failsafe.max_speed or lim.max_linear
+        self._pos_ref: tuple[float, float, float] | None = None  # last accepted north, east, stamp
+        self._pose_jump: tuple[float, str] | None = None  # when and why a position was rejected
         self._last_message: float | None = None
         self._last_heartbeat: float | None = None
         self._heartbeat: Any = None
@@ -171,6 +194,10 @@ class MavlinkDriver:
                 source_component=cfg.source_component, dialect=DIALECT, autoreconnect=True)
         except (OSError, ValueError) as exc:
             raise LinkError(f"cannot open MAVLink connection {self.url!r}: {exc}", field="mavlink.url") from exc
+        if self._secret_key is not None:
+            # sign all we send; refuse unsigned and wrongly signed messages (no unsigned callback)
+            self._conn.setup_signing(self._secret_key, sign_outgoing=True, allow_unsigned_callback=None,
+                                     link_id=cfg.signing_link_id)
         self._stop_event.clear()
         for name, target in (("mavlink-rx", self._rx_loop), ("mavlink-tx", self._tx_loop)):
             thread = threading.Thread(target=target, name=name, daemon=True)
@@ -187,10 +214,21 @@ class MavlinkDriver:
                 self._changed.wait(min(left, 0.1))
         if self._last_heartbeat is None:
             self.close()
+            refused = self.stats["bad_signature"]
+            if refused:
+                raise LinkError(
+                    f"no vehicle HEARTBEAT on {self.url!r} within {cfg.heartbeat_wait_s} s: {refused} "
+                    "messages were refused for a missing or wrong MAVLink 2 signature. Does the vehicle "
+                    "sign with the same key as mavlink.signing_key / signing_key_file?",
+                    field="mavlink.signing_key")
+            heard = self.stats["other_system"] + self.stats["other_component"]
             raise LinkError(
                 f"no vehicle HEARTBEAT on {self.url!r} within {cfg.heartbeat_wait_s} s: is the vehicle "
                 "(or `hiconav vehicle`) running and sending to this address? With udpin the vehicle "
-                "must send to this port; with udpout it must listen on it.", field="mavlink.url")
+                "must send to this port; with udpout it must listen on it."
+                + (f" ({heard} messages came from other systems or components than "
+                   f"target_system {self.target_system} / target_component {self.target_component})"
+                   if heard else ""), field="mavlink.url")
         return self
 
     def engage(self) -> None:
@@ -378,7 +416,8 @@ class MavlinkDriver:
             engaged = self._mode == self.profile.mavlink.guided_mode and (
                 bool(self._armed) or not self.profile.mavlink.arm)
         return {"last_message": self._last_message, "last_heartbeat": self._last_heartbeat,
-                "pose_stamp": self._pose_stamp, "pose": self._pose, "engaged": engaged}
+                "pose_stamp": self._pose_stamp, "pose": self._pose, "engaged": engaged,
+                "pose_jump": self._pose_jump}
 
     def _evaluate(self, now: float):  # -> FailsafeStatus
         with self._lock:
@@ -462,28 +501,49 @@ class MavlinkDriver:
             self.stats["send_errors"] += 1
 
     def _tx_loop(self) -> None:
-        period = 1.0 / self.profile.rates.setpoint_hz
-        hb_period = 1.0 / self.profile.rates.heartbeat_hz
-        next_tick = next_hb = self._clock()
+        self._next_tick = self._next_hb = self._clock()
         while not self._stop_event.is_set():
-            now = self._clock()
-            if now >= next_hb:
-                self._send_heartbeat()
-                next_hb += hb_period
-                if next_hb < now:
-                    next_hb = now + hb_period
-            status = self._evaluate(now)
-            with self._lock:
-                v, w, until = self._setpoint
-                if now > until:
-                    v = w = 0.0
-                v, w, why = self.monitor.gate(status, self._pose, v, w)
-                self._gate_reason = why
-            self._send_velocity(v, w)
-            next_tick += period
-            if next_tick < self._clock():  # overran (a loaded machine): do not burst to catch up
-                next_tick = self._clock() + period
-            self._stop_event.wait(max(0.0, next_tick - self._clock()))
+            wake = self._tick(self._clock())
+            self._stop_event.wait(max(0.0, wake - self._clock()))
+
+    _next_tick: float | None = None
+    _next_hb: float | None = None
+
+    def _tick(self, now: float) -> float:
+        """One sender step at ``now``: GCS heartbeat when due, failsafe check, one setpoint.
+
+        Returns when to run the next: the next setpoint tick (1 / setpoint_hz), or earlier, just
+        after a link / heartbeat / pose timeout would expire, so that a lost link's first zero
+        setpoint goes out link_timeout_s after the last message, not up to a period later.
+        """
+        if self._next_tick is None or self._next_hb is None:
+            self._next_tick = self._next_hb = now
+        period = 1.0 / self.profile.rates.setpoint_hz
+        if now >= self._next_hb:
+            self._send_heartbeat()
+            self._next_hb += 1.0 / self.profile.rates.heartbeat_hz
+            if self._next_hb < now:
+                self._next_hb = now + 1.0 / self.profile.rates.heartbeat_hz
+        status = self._evaluate(now)
+        with self._lock:
+            v, w, until = self._setpoint
+            if now > until:
+                v = w = 0.0
+            v, w, why = self.monitor.gate(status, self._pose, v, w)
+            self._gate_reason = why
+            deadline = self.monitor.next_deadline(now, last_message=self._last_message,
+                                                  last_heartbeat=self._last_heartbeat,
+                                                  pose_stamp=self._pose_stamp)
+        self._send_velocity(v, w)
+        if now >= self._next_tick:
+            self._next_tick += period
+            later = self._clock()
+            if self._next_tick < later:  # overran (a loaded machine): do not burst to catch up
+                self._next_tick = later + period
+        wake = self._next_tick
+        if deadline is not None and deadline + 1e-3 < wake:
+            wake = deadline + 1e-3  # just past it: the timeout compares with ">"
+        return wake
 
     def _rx_loop(self) -> None:
         conn = self._conn
@@ -504,45 +564,56 @@ class MavlinkDriver:
     def _handle(self, msg: Any) -> None:
         kind = msg.get_type()
         if kind == "BAD_DATA":
-            self.stats["bad_data"] += 1
+            if "signature" in str(getattr(msg, "reason", "")):
+                self.stats["bad_signature"] += 1  # unsigned, or signed with another key
+            else:
+                self.stats["bad_data"] += 1
             return
         if msg.get_msgId() < 0:  # framed, but an id this dialect does not know
             self.stats["unknown"] += 1
             return
-        src = msg.get_srcSystem()
+        src, comp = msg.get_srcSystem(), msg.get_srcComponent()
         now = self._clock()
         with self._changed:
-            if self.target_system is None:
-                if kind == "HEARTBEAT" and self._conn.probably_vehicle_heartbeat(msg):
-                    self.target_system = src
-                    self.target_component = msg.get_srcComponent()
-                    # answer at once: on udpin our first heartbeats went nowhere (no peer yet),
-                    # and an autopilot stops guided motion while it hears no GCS
-                    self._send_heartbeat()
-                else:
+            if self.target_system is None or not self._component_locked:
+                if not (kind == "HEARTBEAT" and self._conn.probably_vehicle_heartbeat(msg)
+                        and self.target_system in (None, src)):
+                    if self.target_system is not None and src != self.target_system:
+                        self.stats["other_system"] += 1
                     return
+                self._lock_vehicle(src, comp)
             if src != self.target_system:
                 self.stats["other_system"] += 1
+                return
+            if comp != self.target_component:
+                self.stats["other_component"] += 1
                 return
             if kind == "HEARTBEAT":
                 if msg.type == mavlink.MAV_TYPE_GCS or not self._conn.probably_vehicle_heartbeat(msg):
                     return
                 self._last_message = now
+                first = self._last_heartbeat is None
                 self._last_heartbeat = now
                 self._heartbeat = msg
+                if first:
+                    # answer at once: on udpin our first heartbeats went nowhere (no peer yet),
+                    # and an autopilot stops guided motion while it hears no GCS
+                    self._send_heartbeat()
                 self._mode = mavutil.mode_string_v10(msg)
                 self._armed = bool(msg.base_mode & mavlink.MAV_MODE_FLAG_SAFETY_ARMED)
             elif kind == "LOCAL_POSITION_NED":
                 self._last_message = now
-                self._pos_ned = (msg.x, msg.y, now)
-                self._update_pose(now)
+                if self._accept_position(msg.x, msg.y, now):
+                    self._pos_ned = (msg.x, msg.y, now)
+                    self._update_pose(now)
             elif kind == "ATTITUDE":
                 self._last_message = now
                 self._yaw_ned = (msg.yaw, now)
                 self._update_pose(now)
             elif kind == "ODOMETRY":
                 self._last_message = now
-                if msg.frame_id in (mavlink.MAV_FRAME_LOCAL_NED, mavlink.MAV_FRAME_LOCAL_FRD):
+                if (msg.frame_id in (mavlink.MAV_FRAME_LOCAL_NED, mavlink.MAV_FRAME_LOCAL_FRD)
+                        and self._accept_position(msg.x, msg.y, now)):
                     self._pos_ned = (msg.x, msg.y, now)
                     self._yaw_ned = (quaternion_to_yaw(msg.q), now)
                     self._update_pose(now)
@@ -558,12 +629,48 @@ class MavlinkDriver:
                 return
             self._changed.notify_all()
 
+    def _lock_vehicle(self, system: int, component: int) -> None:
+        """Take the first vehicle heard as the vehicle (the profile did not name it); warn."""
+        what = ("the robot profile names no vehicle (mavlink.target_system 0)" if self.target_system is None
+                else f"the robot profile names system {system} but no component (target_component 0)")
+        self.target_system = system
+        self.target_component = component
+        self._component_locked = True
+        _log.warning(
+            "MAVLink: %s, so the driver locked to the first vehicle heard on %s: system %d, component "
+            "%d. A peer heard first would have been obeyed as the vehicle; set mavlink.target_system "
+            "and mavlink.target_component in the profile to refuse every other.", what, self.url,
+            system, component)
+
+    def _accept_position(self, north: float, east: float, now: float) -> bool:
+        """Whether a reported position is physically possible: finite, and within max_speed x
+        elapsed + pose_jump_margin_m of the last accepted one (driver clock). A rejected one
+        latches the POSE_JUMP failsafe; the pose keeps its last accepted value."""
+        if not (math.isfinite(north) and math.isfinite(east)):
+            self.stats["bad_pose"] += 1
+            return False
+        ref = self._pos_ref
+        if ref is not None:
+            dist = math.hypot(north - ref[0], east - ref[1])
+            elapsed = max(0.0, now - ref[2])
+            margin = self.profile.failsafe.pose_jump_margin_m
+            allowed = self._max_speed * elapsed + margin
+            if dist > allowed:
+                self.stats["pose_jumps"] += 1
+                self._pose_jump = (now, (
+                    f"a reported position {dist:.2f} m from the last one {elapsed:.3f} s earlier was "
+                    f"rejected: at most {allowed:.2f} m is possible (max_speed {self._max_speed:g} m/s "
+                    f"x elapsed + margin {margin:g} m); spoofed or broken odometry?"))
+                return False
+        self._pos_ref = (float(north), float(east), now)
+        return True
+
     def _update_pose(self, now: float) -> None:
         if self._pos_ned is None or self._yaw_ned is None:
             return
         north, east, t_pos = self._pos_ned
         yaw, t_yaw = self._yaw_ned
-        if not all(math.isfinite(v) for v in (north, east, yaw)):
+        if not math.isfinite(yaw):
             self.stats["bad_pose"] += 1
             return
         self._pose = ned_to_enu(north, east, yaw)

@@ -17,7 +17,7 @@ from typing import Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from hiconav import yamlio
 from hiconav.errors import ConfigError
@@ -33,6 +33,7 @@ __all__ = [
     "RobotProfile",
     "available_profiles",
     "load_profile",
+    "parse_signing_key",
     "profile_from_dict",
 ]
 
@@ -116,12 +117,18 @@ class DiscreteProfile(_Model):
 class FailsafeProfile(_Model):
     """Timeouts (s). A latched failsafe (link, heartbeat, geofence, mode) pauses until resume()."""
 
-    link_timeout_s: float = Field(0.5, gt=0.0, le=MAX_DURATION_S, description="no message from the vehicle -> stop, pause")
+    # link loss -> first zero setpoint takes link_timeout_s plus at most one setpoint tick (the
+    # sender also wakes at the loss deadline itself): 0.4 s + 1/20 s leaves margin below 0.5 s
+    link_timeout_s: float = Field(0.4, gt=0.0, le=MAX_DURATION_S, description="no message from the vehicle -> stop, pause")
     heartbeat_timeout_s: float = Field(3.0, gt=0.0, le=MAX_DURATION_S, description="no HEARTBEAT -> stop, pause")
     pose_timeout_s: float = Field(0.5, gt=0.0, le=MAX_DURATION_S, description="pose older than this -> stop")
     command_timeout_s: float = Field(0.5, gt=0.0, le=MAX_DURATION_S, description="no command from the navigator -> zero")
     geofence_lookahead_s: float = Field(1.0, ge=0.0, le=MAX_DURATION_S, description="refuse motion that leaves the fence")
     resume_on_link_recovery: bool = False
+    max_speed: float | None = Field(None, gt=0.0, description="m/s the vehicle can move at most (None: "
+                                    "limits.max_linear); a position farther than max_speed x elapsed "
+                                    "+ pose_jump_margin_m from the last one is rejected")
+    pose_jump_margin_m: float = Field(0.5, ge=0.0, description="m allowed beyond max_speed x elapsed")
 
 
 class GeofenceProfile(_Model):
@@ -156,15 +163,69 @@ class MavlinkProfile(_Model):
     arm: bool = True
     source_system: int = Field(255, ge=1, le=255)
     source_component: int = Field(190, ge=0, le=255)
-    target_system: int = Field(0, ge=0, le=255, description="0 = the first vehicle heard")
-    target_component: int = Field(1, ge=0, le=255)
+    target_system: int = Field(0, ge=0, le=255, description="the vehicle's system id; 0 = the first "
+                               "vehicle heard (logged as a warning: a peer heard first would be obeyed)")
+    target_component: int = Field(1, ge=0, le=255, description="the autopilot's component id (1); "
+                                  "0 = the first heard from target_system")
+    signing_key: str | None = Field(None, description="MAVLink 2 signing: the 32-byte secret key as 64 hex "
+                                    "digits; when set, unsigned or wrongly signed messages are refused")
+    signing_key_file: str | None = Field(None, description="a file holding the signing key (64 hex digits)")
+    signing_link_id: int = Field(0, ge=0, le=255, description="our MAVLink 2 signing link id")
     heartbeat_wait_s: float = Field(10.0, gt=0.0, le=MAX_DURATION_S)
     ack_timeout_s: float = Field(1.5, gt=0.0, le=MAX_DURATION_S)
     retries: int = Field(2, ge=0, le=10)
 
+    @field_validator("signing_key")
+    @classmethod
+    def _check_key(cls, value: str | None) -> str | None:
+        if value is not None:
+            parse_signing_key(value, "signing_key")
+        return value
+
+    @model_validator(mode="after")
+    def _check_signing(self) -> MavlinkProfile:
+        if self.signing_key is not None and self.signing_key_file is not None:
+            raise ValueError("give signing_key or signing_key_file, not both")
+        return self
+
     @property
     def guided_mode(self) -> str:
         return self.mode or ("OFFBOARD" if self.autopilot == "px4" else "GUIDED")
+
+    def secret_key(self) -> bytes | None:
+        """The 32-byte signing key (from signing_key, or read from signing_key_file), or None.
+
+        Raises ``ConfigError`` naming the field (and the file) when it is not 64 hex digits.
+        """
+        if self.signing_key is not None:
+            return parse_signing_key(self.signing_key, "signing_key")
+        if self.signing_key_file is None:
+            return None
+        path = Path(self.signing_key_file).expanduser()
+        try:
+            text = path.read_text(encoding="ascii").strip()
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ConfigError(f"cannot read the MAVLink signing key file: {exc}", file=str(path),
+                              field="mavlink.signing_key_file") from None
+        try:
+            return parse_signing_key(text, "signing_key_file")
+        except ValueError as exc:
+            raise ConfigError(str(exc), file=str(path), field="mavlink.signing_key_file") from None
+
+
+def parse_signing_key(text: str, what: str = "signing key") -> bytes:
+    """A MAVLink 2 secret key (32 bytes) from 64 hex digits (spaces and a 0x prefix allowed)."""
+    digits = "".join(str(text).split())
+    if digits[:2].lower() == "0x":
+        digits = digits[2:]
+    try:
+        key = bytes.fromhex(digits)
+    except ValueError:
+        key = b""
+    if len(key) != 32:
+        raise ValueError(f"{what} must be 64 hex digits (a 32-byte MAVLink 2 secret key), "
+                         f"got {len(digits)} characters")
+    return key
 
 
 class FramesProfile(_Model):

@@ -12,7 +12,9 @@ It behaves as a (much simplified) ArduPilot Rover or PX4 rover autopilot:
   to refuse them (``refuse_modes``, ``refuse_arm``) to test how refusals are reported;
 - its own failsafe: no setpoint for ``setpoint_timeout_s`` or no GCS heartbeat for
   ``gcs_timeout_s`` -> velocity 0 (PX4 also leaves OFFBOARD for LOITER/hold);
-- ignores malformed bytes and messages it does not handle;
+- ignores malformed bytes and messages it does not handle; with ``signing_key`` it signs what it
+  sends (MAVLink 2 signing) and refuses unsigned or wrongly signed messages, as an autopilot with
+  signing enabled does;
 - moves as a unicycle; with a House, a move that would put the robot disk (``robot_radius``) on a
   non-navigable cell of ``house.nav`` is refused (collision), as in the simulator.
 
@@ -63,10 +65,13 @@ class VehicleConfig:
     refuse_arm: bool = False
     px4_requires_stream: bool = True  # PX4: OFFBOARD only with a live setpoint stream
     px4_offboard_loss_hold: bool = True  # PX4: setpoint loss -> leave OFFBOARD for hold
+    signing_key: bytes | None = None  # MAVLink 2 signing (32 bytes): sign out, refuse unsigned in
 
     def __post_init__(self) -> None:
         if self.autopilot not in ("ardupilot", "px4"):
             raise ValueError(f"autopilot must be 'ardupilot' or 'px4', got {self.autopilot!r}")
+        if self.signing_key is not None and len(self.signing_key) != 32:
+            raise ValueError(f"signing_key must be 32 bytes, got {len(self.signing_key)}")
 
     @property
     def guided_mode(self) -> str:
@@ -141,6 +146,8 @@ class SimulatedVehicle:
                                                     dialect=DIALECT)
         except (OSError, ValueError) as exc:
             raise LinkError(f"vehicle cannot open {self.url!r}: {exc}", field="listen") from exc
+        if self.config.signing_key is not None:
+            self._conn.setup_signing(self.config.signing_key, sign_outgoing=True, allow_unsigned_callback=None)
         self._stop_event.clear()
         self._thread = threading.Thread(target=self._loop, name="sim-vehicle", daemon=True)
         self._thread.start()
@@ -297,7 +304,10 @@ class SimulatedVehicle:
     def _handle(self, msg: Any, now: float) -> None:
         kind = msg.get_type()
         if kind == "BAD_DATA":
-            self.counters["bad_data"] += 1
+            if "signature" in str(getattr(msg, "reason", "")):
+                self.counters["bad_signature"] += 1
+            else:
+                self.counters["bad_data"] += 1
             return
         if msg.get_msgId() < 0:  # a well-framed message of an id this dialect does not know
             self.counters["unknown"] += 1

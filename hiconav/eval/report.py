@@ -156,6 +156,14 @@ def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
     return "\n".join(lines)
 
 
+def _legend(ax: Any, **options: Any) -> None:
+    """A legend only when something on ``ax`` has a label (else matplotlib warns "No artists
+    with labels found to put in legend")."""
+    handles, _ = ax.get_legend_handles_labels()
+    if handles:
+        ax.legend(**options)
+
+
 def write_plots(out: str | Path, records: Sequence[EpisodeRecord], summary: dict[str, Any]) -> dict[str, str]:
     """The four PNG plots in ``out``; returns {title: file name} of those written."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -193,8 +201,7 @@ def write_plots(out: str | Path, records: Sequence[EpisodeRecord], summary: dict
     ax.set_xlabel("SPL")
     ax.set_ylabel("episodes")
     ax.set_title("SPL histogram")
-    if presets:
-        ax.legend(fontsize=7)
+    _legend(ax, fontsize=7)
     save(fig, "spl_hist", "SPL histogram")
 
     fig = Figure(figsize=(max(5.0, 1.0 * len(presets) + 3), 3.4))
@@ -209,7 +216,7 @@ def write_plots(out: str | Path, records: Sequence[EpisodeRecord], summary: dict
     ax.set_ylabel("episodes (%)")
     ax.set_title("Outcome breakdown (failure taxonomy)")
     ax.tick_params(axis="x", rotation=30)
-    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.0, 0.5))
+    _legend(ax, fontsize=7, loc="center left", bbox_to_anchor=(1.0, 0.5))
     save(fig, "failures", "Failure breakdown")
 
     layers = presets.get(main, {}).get("timing", {}).get("layers", {}) if main else {}

@@ -24,6 +24,9 @@ This module must not know about anchors, objects or frames: it works on a cost v
 from __future__ import annotations
 
 import math
+import os
+import sys
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,6 +41,9 @@ except ImportError:  # pragma: no cover - depends on the environment
     highspy = None
 
 from hiconav.errors import DataError, HiconavError
+
+_banner_lock = threading.Lock()
+_banner_muted = False
 
 __all__ = [
     "SetCoverError",
@@ -326,9 +332,48 @@ def _highs_model(c: np.ndarray, A: sp.csr_matrix, req: np.ndarray, integral: boo
     lp.a_matrix_.value_ = Ac.data.astype(np.float64)
     if integral:
         lp.integrality_ = [highspy.HighsVarType.kInteger] * n
-    h = highspy.Highs()
-    h.setOptionValue("output_flag", False)
+    h = _quiet_highs()
     h.passModel(lp)
+    return h
+
+
+def _quiet_highs() -> highspy.Highs:
+    """A ``highspy.Highs`` with ``output_flag`` off, and no copyright banner.
+
+    HiGHS prints its banner to the C stdout when the first ``Highs`` of the process is built,
+    before any option can be set, so that first construction runs with file descriptor 1 on
+    /dev/null (a few microseconds; C buffers flushed before it is restored). Later ones print
+    nothing.
+    """
+    global _banner_muted
+    with _banner_lock:
+        if _banner_muted:
+            h = highspy.Highs()
+        else:
+            h = _construct_muted()
+            _banner_muted = True
+    h.setOptionValue("output_flag", False)
+    return h
+
+
+def _construct_muted() -> highspy.Highs:
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None)
+        sys.stdout.flush()
+        saved = os.dup(1)
+    except (OSError, AttributeError, ValueError):  # no libc or no fd 1 (e.g. embedded): banner and all
+        return highspy.Highs()
+    null = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 1)
+        h = highspy.Highs()
+        libc.fflush(None)
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(null)
     return h
 
 
@@ -420,7 +465,7 @@ def _solve_mip(c: np.ndarray, A: sp.csr_matrix, req: np.ndarray, start: np.ndarr
         res = milp(c, integrality=np.ones(c.size), bounds=Bounds(0.0, 1.0),
                    constraints=LinearConstraint(A, lb=req.astype(np.float64), ub=np.inf),
                    options={"time_limit": time_limit, "mip_rel_gap": mip_rel_gap,
-                            "presolve": presolve})
+                            "presolve": presolve, "disp": False})
         lb = getattr(res, "mip_dual_bound", None)
         return _MipOutcome(res.x, int(res.status), str(res.message),
                            None if lb is None or not np.isfinite(lb) else float(lb))

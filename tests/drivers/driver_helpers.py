@@ -35,6 +35,41 @@ def wait_until(predicate: Callable[[], bool], timeout: float, period: float = 0.
     return bool(predicate())
 
 
+READY_S = 120.0  # how long a subprocess may take to get ready on a loaded 2-core machine
+
+
+class LineReader:
+    """Reads a subprocess's text stream on a thread, so a test can wait for a readiness line with
+    a deadline (a blocking ``readline`` has none). ``lines`` keeps everything read."""
+
+    def __init__(self, stream) -> None:
+        self.lines: list[str] = []
+        self._new = threading.Condition()
+        self._thread = threading.Thread(target=self._run, args=(stream,), daemon=True)
+        self._thread.start()
+
+    def _run(self, stream) -> None:
+        for line in stream:
+            with self._new:
+                self.lines.append(line.rstrip("\n"))
+                self._new.notify_all()
+
+    def wait_for(self, text: str, timeout: float = READY_S) -> bool:
+        """True once a line containing ``text`` has been read, False after ``timeout`` s or EOF."""
+        deadline = time.monotonic() + timeout
+        with self._new:
+            while not any(text in line for line in self.lines):
+                left = deadline - time.monotonic()
+                if left <= 0 or not self._thread.is_alive():
+                    return any(text in line for line in self.lines)
+                self._new.wait(min(left, 0.5))
+            return True
+
+    def text(self) -> str:
+        self._thread.join(timeout=READY_S)
+        return "\n".join(self.lines)
+
+
 def test_profile(**sections: dict) -> RobotProfile:
     """A MAVLink profile for tests: fast limits, short waits."""
     data: dict = {"name": "test", "driver": "mavlink",

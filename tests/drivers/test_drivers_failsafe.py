@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import os
 import signal
 
 import pytest
@@ -69,6 +68,33 @@ def test_never_connected_is_not_latched():
     assert m.evaluate(2.0, **healthy(2.0)).ok
 
 
+def test_pose_before_the_first_heartbeat_is_not_a_heartbeat_loss():
+    # a vehicle named in the profile is heard (poses) before its first HEARTBEAT arrives
+    m = FailsafeMonitor(FailsafeProfile())
+    s = m.evaluate(1.0, **healthy(1.0, last_heartbeat=None, engaged=None))
+    assert s.state == FailsafeState.HEARTBEAT_LOST and not s.paused
+    assert m.evaluate(2.0, **healthy(2.0)).ok
+
+
+def test_a_rejected_pose_jump_latches_until_jumps_stop():
+    m = FailsafeMonitor(FailsafeProfile(pose_timeout_s=0.5))
+    jump = (10.0, "a reported position 1414.21 m from the last one was rejected")
+    s = m.evaluate(10.0, **healthy(10.0, pose_jump=jump))
+    assert s.state == FailsafeState.POSE_JUMP and s.paused and "1414" in s.reason
+    assert m.gate(s, P0, 0.3, 0.0)[:2] == (0.0, 0.0)
+    ok, why = m.resume(10.2, **healthy(10.2, pose_jump=jump))
+    assert not ok and "rejected" in why
+    assert m.resume(10.6, **healthy(10.6, pose_jump=jump))[0]
+    assert m.evaluate(10.6, **healthy(10.6, pose_jump=jump)).ok
+
+
+def test_next_deadline_is_the_earliest_timeout_still_ahead():
+    m = FailsafeMonitor(FailsafeProfile(link_timeout_s=0.4, heartbeat_timeout_s=3.0, pose_timeout_s=0.5))
+    assert m.next_deadline(10.0, last_message=9.9, last_heartbeat=9.5, pose_stamp=9.95) == pytest.approx(10.3)
+    assert m.next_deadline(10.5, last_message=9.9, last_heartbeat=9.5, pose_stamp=9.95) == pytest.approx(12.5)
+    assert m.next_deadline(1.0, last_message=None, last_heartbeat=None, pose_stamp=None) is None
+
+
 def test_heartbeat_loss_latches():
     m = FailsafeMonitor(FailsafeProfile(heartbeat_timeout_s=3.0))
     s = m.evaluate(10.0, **healthy(10.0, last_heartbeat=6.0))
@@ -117,7 +143,9 @@ def test_sigint_hook_stops_then_raises_keyboard_interrupt():
     uninstall = install_stop_handlers(lambda: calls.append("stop"))
     try:
         with pytest.raises(KeyboardInterrupt):
-            os.kill(os.getpid(), signal.SIGINT)
+            # raise_signal delivers to this (the main) thread and runs the Python handler before
+            # it returns; os.kill(getpid()) may run it later, on a loaded machine outside this block
+            signal.raise_signal(signal.SIGINT)
         assert calls == ["stop"]
     finally:
         uninstall()

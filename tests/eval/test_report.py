@@ -40,3 +40,17 @@ def test_main_table_shows_the_measured_sr(tmp_path) -> None:
     row = next(line for line in (tmp_path / "report.md").read_text().splitlines() if line.startswith("| full"))
     assert f"{100 * summary['success_rate']:.1f}" in row
     assert "Only one preset ran" in (tmp_path / "report.md").read_text()
+
+
+def test_a_report_without_labelled_plots_writes_no_legend_warning(tmp_path, recwarn, capsys) -> None:
+    """Every episode invalid: nothing in the SPL histogram or the outcome bars carries a label, so
+    no legend is drawn (matplotlib would warn "No artists with labels found")."""
+    from hiconav.eval.records import EpisodeRecord
+    from hiconav.eval.report import write_report
+    from hiconav.eval.summary import summarize
+
+    records = [EpisodeRecord(episode_id="e0", house="h", target="bed", preset="full", failure="invalid_episode")]
+    write_report(tmp_path, records, summarize(records))
+    assert (tmp_path / "report.md").is_file() and (tmp_path / "failures.png").is_file()
+    assert [str(w.message) for w in recwarn] == []
+    assert capsys.readouterr() == ("", "")

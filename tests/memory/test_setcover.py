@@ -194,3 +194,22 @@ def test_time_out_after_fixing_keeps_a_feasible_labelled_fallback(monkeypatch):
     assert res.status == "greedy-fallback" and not res.proven_optimal
     assert is_feasible_cover(A, req, np.array(res.selected))
     assert res.lower_bound is not None and res.lower_bound <= optimum + 1e-9 <= res.cost + 1e-9
+
+
+def test_a_solve_prints_no_highs_banner() -> None:
+    """HiGHS prints its copyright banner once per process, when the first Highs is built (before
+    output_flag can be set): a fresh process solves one ILP and must print nothing."""
+    import subprocess
+    import sys
+
+    script = (
+        "import numpy as np, scipy.sparse as sp\n"
+        "import hiconav.memory.setcover as sc\n"
+        "assert sc.highspy is not None, 'highspy is a dependency'\n"
+        "A = sp.csr_matrix(np.array([[1, 1, 0], [0, 1, 1], [1, 0, 1]], float))\n"
+        "r = sc.solve_multicover(np.array([1.0, 2.0, 1.0]), A, np.ones(3))\n"
+        "assert r.status == 'optimal', r.status\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == "" and proc.stderr == "", (proc.stdout, proc.stderr)
