@@ -74,36 +74,42 @@ def plan_overlap(a: Thing, b: Thing, margin: float = OVERLAP_MARGIN) -> bool:
     return True
 
 
-def _segment_distance(p: np.ndarray, q: np.ndarray, r: np.ndarray, s: np.ndarray) -> float:
-    """Shortest distance between segments pq and rs (2D) that do not cross."""
-    def point_segment(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
-        d = b - a
-        t = 0.0 if not d.any() else float(np.clip((x - a) @ d / (d @ d), 0.0, 1.0))
-        return float(np.linalg.norm(x - (a + t * d)))
-    return min(point_segment(p, r, s), point_segment(q, r, s), point_segment(r, p, q),
-               point_segment(s, p, q))
+def _point_segment(px: float, py: float, ax: float, ay: float, bx: float, by: float) -> float:
+    dx, dy = bx - ax, by - ay
+    dd = dx * dx + dy * dy
+    t = 0.0 if dd == 0.0 else min(max(((px - ax) * dx + (py - ay) * dy) / dd, 0.0), 1.0)
+    return math.hypot(px - ax - t * dx, py - ay - t * dy)
 
 
 def planar_gap(a: Thing, b: Thing) -> float:
     """Shortest planar distance (m) between the two footprints; 0 where they touch or overlap."""
-    pa, pb = a.corners(), b.corners()
     if plan_overlap(a, b, margin=0.0):
         return 0.0
+    pa, pb = a.corners().tolist(), b.corners().tolist()
     best = math.inf
-    for i in range(4):
-        for j in range(4):
-            best = min(best, _segment_distance(pa[i], pa[(i + 1) % 4], pb[j], pb[(j + 1) % 4]))
+    # disjoint convex polygons: the shortest distance runs from a corner of one to an edge of the other
+    for p, q in ((pa, pb), (pb, pa)):
+        for x, y in p:
+            for k in range(4):
+                (ax, ay), (bx, by) = q[k - 1], q[k]
+                best = min(best, _point_segment(x, y, ax, ay, bx, by))
     return best
+
+
+def gap_lower_bound(a: Thing, b: Thing) -> float:
+    """A cheap lower bound of ``planar_gap``: centre distance less both half-diagonals."""
+    return math.hypot(a.center[0] - b.center[0], a.center[1] - b.center[1]) \
+        - 0.5 * math.hypot(a.size[0], a.size[1]) - 0.5 * math.hypot(b.size[0], b.size[1])
 
 
 def is_next_to(a: Thing, b: Thing, within: float = NEXT_TO) -> bool:
     """"a next to b" / "a beside b": the footprints lie at most ``within`` m apart."""
-    return planar_gap(a, b) <= within
+    return gap_lower_bound(a, b) <= within and planar_gap(a, b) <= within
 
 
 def is_near(a: Thing, b: Thing, within: float = NEAR) -> bool:
     """"a near b" / "a close to b": the footprints lie at most ``within`` m apart."""
-    return planar_gap(a, b) <= within
+    return gap_lower_bound(a, b) <= within and planar_gap(a, b) <= within
 
 
 def is_on(a: Thing, b: Thing) -> bool:

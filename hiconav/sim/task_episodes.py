@@ -45,8 +45,8 @@ from typing import Any
 import numpy as np
 
 from hiconav.errors import DataError
-from hiconav.relations import NEAR, NEXT_TO, Thing, in_polygon, is_near, is_next_to, is_on, is_under, \
-    planar_gap, polygon_distance
+from hiconav.relations import NEAR, NEXT_TO, Thing, gap_lower_bound, in_polygon, is_near, is_next_to, is_on, \
+    is_under, planar_gap, polygon_distance
 from hiconav.sim.episodes import TARGET_CATEGORIES, generate_episodes
 from hiconav.sim.geodesic import GoalDistance, centre_free, house_graph
 from hiconav.sim.house import House, SimObject
@@ -171,6 +171,7 @@ class GroundTruth:
         self.things = [thing_of(o) for o in house.objects]
         self._visible = visible
         self._rooms: dict[int, str | None] = {}
+        self._memo: dict[tuple[str, int, Clause], bool] = {}
 
     def room_of(self, iid: int) -> str | None:
         """The ProcTHOR roomType of the room whose polygon holds the object's centre (or lies
@@ -205,6 +206,20 @@ class GroundTruth:
         raise ValueError(f"unknown relation {relation!r}")
 
     def may_satisfy(self, iid: int, clause: Clause) -> bool:
+        """Whether ``iid`` might be what the clause describes (read generously; memoised)."""
+        key = ("may", iid, clause)
+        if key not in self._memo:
+            self._memo[key] = self._may_satisfy(iid, clause)
+        return self._memo[key]
+
+    def satisfies(self, iid: int, clause: Clause) -> bool:
+        """Whether ``iid`` is what the clause describes (read strictly; memoised)."""
+        key = ("does", iid, clause)
+        if key not in self._memo:
+            self._memo[key] = self._satisfies(iid, clause)
+        return self._memo[key]
+
+    def _may_satisfy(self, iid: int, clause: Clause) -> bool:
         """Whether ``iid`` might be what the clause describes, read generously: any object of the
         anchor category, ProcTHOR's parent or the geometry for "on", an unknown room for any room."""
         kind, what = clause
@@ -217,7 +232,7 @@ class GroundTruth:
         return any(self._related(kind, iid, o.instance_id) for o in self.house.objects
                    if o.category == what and o.instance_id != iid)
 
-    def satisfies(self, iid: int, clause: Clause) -> bool:
+    def _satisfies(self, iid: int, clause: Clause) -> bool:
         """Whether ``iid`` is what the clause describes, read strictly: a landmark anchor, and
         for "on" its ProcTHOR parent that the geometry also puts it on."""
         kind, what = clause
@@ -249,7 +264,7 @@ class GroundTruth:
         rank = {"on": 0, "under": 1, "next to": 2, "near": 3}
         for o in self.house.objects:
             j = o.instance_id
-            if j == iid or o.category == obj.category:
+            if j == iid or o.category == obj.category or gap_lower_bound(me, self.things[j]) > NEAR:
                 continue
             gap = planar_gap(me, self.things[j])
             if gap > NEAR:
