@@ -45,8 +45,7 @@ from typing import Any
 import numpy as np
 
 from hiconav.errors import DataError
-from hiconav.relations import NEAR, NEXT_TO, Thing, gap_lower_bound, in_polygon, is_near, is_next_to, is_on, \
-    is_under, planar_gap, polygon_distance
+from hiconav.relations import NEAR, NEXT_TO, Thing, gap_lower_bound, holds, in_polygon, planar_gap, polygon_distance
 from hiconav.sim.episodes import TARGET_CATEGORIES, generate_episodes
 from hiconav.sim.geodesic import GoalDistance, centre_free, house_graph
 from hiconav.sim.house import House, SimObject
@@ -194,16 +193,7 @@ class GroundTruth:
         return True if self._visible is None else bool(self._visible(iid))
 
     def _related(self, relation: str, a: int, b: int) -> bool:
-        ta, tb = self.things[a], self.things[b]
-        if relation == "next to":
-            return is_next_to(ta, tb)
-        if relation == "near":
-            return is_near(ta, tb)
-        if relation == "under":
-            return is_under(ta, tb)
-        if relation == "on":
-            return is_on(ta, tb)
-        raise ValueError(f"unknown relation {relation!r}")
+        return holds(relation, self.things[a], self.things[b])
 
     def may_satisfy(self, iid: int, clause: Clause) -> bool:
         """Whether ``iid`` might be what the clause describes (read generously; memoised)."""
