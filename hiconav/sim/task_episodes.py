@@ -16,9 +16,10 @@ goal's success region).
 - **ovon**: the same draws over the categories people name with other words; the instruction
   names the target with one of ``OVON_NAMES`` (never the category's own words) in one of
   ``OVON_PHRASINGS`` ("take me to the fridge", "where is the nightstand?").
-- **textnav**: only categories with two or more visible instances; the instruction describes one
-  of them by what a person sees: its room, an object it stands on, one next to it (planar gap <= 1
-  m), near it (<= 2 m) or above it (``hiconav.relations``). The description is checked on the
+- **textnav**: only categories with two or more visible instances (the category drawn uniformly,
+  then one of its instances); the instruction describes the instance by what a person sees: its
+  room, an object it stands on, one next to it (planar gap <= 1 m), near it (<= 2 m) or above it
+  (``hiconav.relations``). The description is checked on the
   ground truth to single out that instance: every other instance of the category fails one of
   its clauses, read generously (any object of the anchor category, a ProcTHOR parent or the box
   geometry, an unknown room counts as any room), while the described instance satisfies each
@@ -380,10 +381,17 @@ def _textnav(house: House, house_index: int, n: int, seed: int) -> list[TaskEpis
     if not usable:
         raise DataError(f"{house.name} has no instance that a description singles out among two or more "
                         "visible instances of a target category", field="task")
+    # the category first, uniformly, then one of its described instances (as objectnav draws the
+    # category): drawing instances alone made every third episode a painting
+    by_category: dict[str, list[tuple[int, list[Clause], np.ndarray]]] = {}
+    for entry in usable:
+        by_category.setdefault(house.objects[entry[0]].category, []).append(entry)
+    categories = sorted(by_category)
     rng = np.random.default_rng(seed)
     out = []
     for i in range(n):
-        iid, clauses, cells = usable[int(rng.integers(len(usable)))]
+        group = by_category[categories[int(rng.integers(len(categories)))]]
+        iid, clauses, cells = group[int(rng.integers(len(group)))]
         rc = cells[int(rng.integers(len(cells)))]
         xy = house.nav.cell_to_world(rc)
         yaw = float(rng.uniform(-math.pi, math.pi))
