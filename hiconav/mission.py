@@ -433,7 +433,8 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
     house = load_house(spec.house)
     start = Pose2D(*map(float, spec.start))
     episode = Episode(spec.episode_id, house.name, start, spec.target, tuple(spec.goal_instance_ids),
-                      float(spec.geodesic_distance), spec.instruction or instruction_for(spec.target))
+                      float(spec.geodesic_distance), spec.instruction or instruction_for(spec.target),
+                      task=getattr(spec, "task", "objectnav"))
     wall0 = time.perf_counter()
     result = run_mission(house, episode, seed=seed, overrides=overrides, clock="stepped")
     m = result.metrics

@@ -85,7 +85,7 @@ def eval(
     houses: Path | None = typer.Option(None, "--houses", help="ProcTHOR houses FILE.jsonl.gz (episodes are generated)."),
     episodes_per_house: int = typer.Option(3, "--episodes-per-house", min=1, help="Generated episodes per house/floor."),
     maps: Path | None = typer.Option(None, "--maps", help="Gibson semantic maps FILE.pbz2."),
-    episodes: list[Path] | None = typer.Option(None, "--episodes", help="Habitat ObjectNav episode files or folders (with --maps; without: generated)."),
+    episodes: list[Path] | None = typer.Option(None, "--episodes", help="With --maps: Habitat ObjectNav episode files or folders; with --houses: task episode files FILE.jsonl (objectnav, ovon, textnav; hiconav episodes writes them). Without: generated."),
     seed: int = typer.Option(0, "--seed", help="Base seed (episode generation and per-episode seeds)."),
     limit: int | None = typer.Option(None, "--limit", min=1, help="Run only the first N episodes."),
     workers: int | None = typer.Option(None, "--workers", min=0, help="Worker processes (default: core count; 0 = in this process)."),
@@ -104,12 +104,10 @@ def eval(
     from hiconav.eval.config import EvalConfig
     from hiconav.eval.presets import resolve_presets
     from hiconav.eval.runner import evaluate
-    from hiconav.eval.sources import gibson_source, invalid_reason, procthor_source, validate_spec
+    from hiconav.eval.sources import gibson_source, invalid_reason, procthor_source, task_episode_source, validate_spec
 
     if (houses is None) == (maps is None):
         raise ConfigError("give exactly one input: --houses FILE.jsonl.gz or --maps FILE.pbz2", field="--houses/--maps")
-    if episodes and maps is None:
-        raise ConfigError("--episodes (Habitat episode files) goes with --maps", field="--episodes")
     if scenes and maps is None:
         raise ConfigError("--scenes selects Gibson floors: it goes with --maps", field="--scenes")
     if backend not in ("local", "ray"):
@@ -134,6 +132,8 @@ def eval(
     if scenes:
         source["scenes"] = scenes
     def build() -> list[Any]:
+        if houses is not None and episodes:
+            return task_episode_source(houses, episodes, limit=limit)
         if houses is not None:
             return procthor_source(houses, episodes_per_house, seed=seed, limit=limit, workers=n_workers)
         return gibson_source(maps, episodes, episodes_per_house=episodes_per_house, seed=seed, limit=limit,

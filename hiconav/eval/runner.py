@@ -97,6 +97,9 @@ def run_task(task: Task) -> EpisodeRecord:
                      target=record.target or spec.target, preset=task.preset, seed=task.seed,
                      geodesic_distance=record.geodesic_distance or spec.geodesic_distance,
                      wall_time_s=record.wall_time_s or wall)
+    task_name = getattr(spec, "task", "objectnav")
+    if task_name != "objectnav":  # ObjectNav records stay as they were; other tasks say which
+        record = replace(record, extra={**record.extra, "task": task_name})
     failure = classify(record.to_json(), stuck_window=task.stuck_window).value
     return replace(record, failure=failure)
 

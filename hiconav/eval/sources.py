@@ -46,6 +46,7 @@ class EpisodeSpec:
     instruction: str = ""
     source_id: str = ""
     error: str | None = None
+    task: str = "objectnav"  # objectnav | ovon | textnav (hiconav.sim.task_episodes)
 
     @staticmethod
     def from_episode(episode: Any, *, episode_id: str | None = None) -> EpisodeSpec:
@@ -60,6 +61,7 @@ class EpisodeSpec:
             geodesic_distance=float(episode.geodesic_distance),
             instruction=str(getattr(episode, "instruction", "") or ""),
             source_id=str(episode.episode_id),
+            task=str(getattr(episode, "task", "objectnav") or "objectnav"),
         )
 
     def to_episode(self) -> Any:
@@ -75,6 +77,7 @@ class EpisodeSpec:
             goal_instance_ids=tuple(self.goal_instance_ids),
             geodesic_distance=self.geodesic_distance,
             instruction=self.instruction,
+            task=self.task,
         )
 
     def load_house(self) -> Any:
@@ -82,10 +85,13 @@ class EpisodeSpec:
         return load_house_cached(self.house)
 
     def to_json(self) -> dict[str, Any]:
-        return {"episode_id": self.episode_id, "house": self.house, "target": self.target,
+        data = {"episode_id": self.episode_id, "house": self.house, "target": self.target,
                 "start": list(self.start), "goal_instance_ids": list(self.goal_instance_ids),
                 "geodesic_distance": self.geodesic_distance, "instruction": self.instruction,
                 "source_id": self.source_id, "error": self.error}
+        if self.task != "objectnav":  # ObjectNav specs are written as they always were
+            data["task"] = self.task
+        return data
 
     @staticmethod
     def from_json(data: dict[str, Any]) -> EpisodeSpec:
@@ -94,7 +100,8 @@ class EpisodeSpec:
                            goal_instance_ids=tuple(int(i) for i in data.get("goal_instance_ids", ())),
                            geodesic_distance=float(data.get("geodesic_distance", 0.0)),
                            instruction=str(data.get("instruction", "")),
-                           source_id=str(data.get("source_id", "")), error=data.get("error"))
+                           source_id=str(data.get("source_id", "")), error=data.get("error"),
+                           task=str(data.get("task", "objectnav")))
 
 
 @functools.lru_cache(maxsize=8)
@@ -167,6 +174,69 @@ def procthor_source(houses_file: str | Path, episodes_per_house: int, seed: int 
         raise DataError("must be at least 1", field="--episodes-per-house")
     specs = procthor_house_specs(houses_file)
     return _take(_generated(specs, episodes_per_house, seed, limit, workers), limit)
+
+
+def task_episode_source(houses_file: str | Path, episode_files: Sequence[str | Path],
+                        limit: int | None = None) -> list[EpisodeSpec]:
+    """The episodes of task episode files (``hiconav.sim.task_episodes``: JSON Lines, one
+    objectnav / ovon / textnav episode a line) on the houses of ``houses_file``, in file and line
+    order, the first ``limit`` when given. A line that cannot be used (bad JSON or field, unknown
+    task, house line or object id, a start off the robot's free space, an unreachable goal)
+    becomes one spec with ``error`` naming the file, line and field; a missing or unreadable
+    file is reported at once."""
+    house_specs = procthor_house_specs(houses_file)
+    files = [_require_file(path, "--episodes") for path in episode_files]
+    for path in files:
+        if path.is_dir():
+            raise DataError("expected a task episode file (JSON Lines), got a folder", file=str(path),
+                            field="--episodes")
+    return _take(_task_episodes(files, house_specs), limit)
+
+
+def _task_episodes(files: Sequence[Path], house_specs: Sequence[str]) -> Iterator[EpisodeSpec]:
+    from hiconav.sim.task_episodes import parse_line, resolve
+
+    for path in files:
+        opener = gzip.open if path.suffix == ".gz" else open
+        try:
+            with opener(path, "rt", encoding="utf-8") as fh:
+                lines = fh.read().splitlines()
+        except (OSError, EOFError, UnicodeDecodeError) as exc:
+            raise DataError(f"cannot read task episodes: {exc}", file=str(path), field="--episodes") from exc
+        first_line: dict[str, int] = {}
+        for number, text in enumerate(lines, start=1):
+            if not text.strip():
+                continue
+            where = f"{path.name}:{number}"
+            house_spec, target, episode_id = "", "", where
+            try:
+                episode = parse_line(text, str(path), number)
+                episode_id, target = episode.episode_id, episode.target
+                if episode.episode_id in first_line:
+                    raise DataError(f"episode_id {episode.episode_id!r} is given twice (first at line "
+                                    f"{first_line[episode.episode_id]})", file=str(path), line=number,
+                                    field="episode_id")
+                first_line[episode.episode_id] = number
+                if episode.house >= len(house_specs):
+                    raise DataError(f"house {episode.house} is not a line of the houses file (0.."
+                                    f"{len(house_specs) - 1})", file=str(path), line=number, field="house")
+                house_spec = house_specs[episode.house]
+                try:
+                    house = load_house_cached(house_spec)
+                except Exception as exc:  # noqa: BLE001 - bad input: recorded, never aborts
+                    raise DataError(f"cannot load house {house_spec}: {exc}", file=str(path), line=number,
+                                    field="house") from exc
+                ids, distance = resolve(episode, house, str(path), number)
+            except ImportError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - bad input: recorded as an invalid episode, never aborts
+                message = str(exc) if isinstance(exc, HiconavError) else \
+                    f"{path}:{number}: {type(exc).__name__}: {exc}"
+                yield EpisodeSpec(episode_id=episode_id, house=house_spec or where, target=target, error=message)
+                continue
+            yield EpisodeSpec(episode_id=episode.episode_id, house=house_spec, target=episode.target,
+                              start=episode.start, goal_instance_ids=ids, geodesic_distance=distance,
+                              instruction=episode.instruction, source_id=episode.episode_id, task=episode.task)
 
 
 def generate_for_house(house_spec: str, n: int, seed: int) -> list[EpisodeSpec]:
@@ -411,6 +481,16 @@ _REASONS: tuple[tuple[str, str], ...] = (
     ("start off the robot's free space", "start off the robot's free space"),
     ("cannot load house", "house cannot be loaded"),
     ("unknown house", "house cannot be loaded"),
+    ("is off the robot's free space", "start off the robot's free space"),
+    ("unknown ProcTHOR object id", "unknown goal object id"),
+    ("not the target", "goal object of another category"),
+    ("unknown task", "unknown task"),
+    ("is not a line of the houses file", "house not in the houses file"),
+    ("is given twice", "episode id given twice"),
+    ("malformed JSON", "malformed episode line"),
+    ("missing field", "missing or bad field"),
+    ("unknown field", "missing or bad field"),
+    ("expected ", "missing or bad field"),
 )
 
 

@@ -83,7 +83,7 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("armchair", "arm chair", "recliner", "easy chair", "lounge chair", "accent chair"):
         ("armchair", "arm_chair", "chair"),
     ("bed", "double bed", "single bed", "king bed", "queen bed", "bunk bed"): ("bed",),
-    ("toilet", "wc", "commode", "loo", "water closet", "toilet bowl"): ("toilet",),
+    ("toilet", "wc", "commode", "loo", "water closet", "toilet bowl", "lavatory"): ("toilet",),
     ("sink", "washbasin", "wash basin", "basin", "kitchen sink", "bathroom sink", "handbasin"):
         ("sink",),
     ("bathtub", "bath tub", "tub", "bath"): ("bathtub",),
@@ -270,6 +270,8 @@ find|find me|locate|look for|search for|search|seek|spot|detect|identify|look at
 go to|go find|go and find|go towards|go toward|go near|go over to|go|navigate to|navigate towards|
 navigate|move to|move towards|walk to|walk towards|walk over to|head to|head towards|head for|
 get to|get close to|get near|get me to|take me to|bring me to|lead me to|drive to|approach|
+head over to|get over to|make your way to|go up to|walk up to|
+i need to get to|i need to go to|i want to go to|i want to get to|i have to get to|
 reach|visit|show me|where is|where's|where are|i'm looking for|i am looking for|
 i want to find|i need to find|i need|i want|i lost|we need|
 stop at|stop by|stop near|go stand by|stand next to|stand by|end up at|come to|

@@ -57,11 +57,14 @@ class Episode:
     goal_instance_ids: tuple[int, ...]
     geodesic_distance: float
     instruction: str
+    task: str = "objectnav"  # objectnav | ovon | textnav (hiconav.sim.task_episodes)
 
     def to_json(self) -> dict[str, Any]:
         d = asdict(self)
         d["start"] = [self.start.x, self.start.y, self.start.yaw]
         d["goal_instance_ids"] = list(self.goal_instance_ids)
+        if self.task == "objectnav":  # ObjectNav episodes are written as they always were
+            d.pop("task")
         return d
 
 

@@ -52,7 +52,8 @@ class SimObject:
     center: (3,) world metres (box centre); size: (3,) metres along the box's own x, y, z
     (z is vertical); yaw: rad, rotation of the box's x axis from world +x (CCW).
     ``category``: lowercase snake case (bed, sofa, chair, tv, plant, dining_table, ...);
-    ``source_type``: the data set's own type name (e.g. ProcTHOR "HousePlant").
+    ``source_type``: the data set's own type name (e.g. ProcTHOR "HousePlant"); ``source_id``:
+    the data set's own id of the instance (ProcTHOR's object "id", e.g. "Chair|2|3"; "" if none).
     """
 
     instance_id: int
@@ -63,6 +64,7 @@ class SimObject:
     source_type: str
     parent_id: int | None = None
     default_size: bool = False  # True when the size is a fallback (Objaverse assets)
+    source_id: str = ""
 
     def __post_init__(self) -> None:
         freeze(self.center)
@@ -227,6 +229,18 @@ class House:
 
     def instances_of(self, category: str) -> list[SimObject]:
         return [o for o in self.objects if o.category == category]
+
+    def instance_by_source_id(self, source_id: str) -> int | None:
+        """The instance id of the object whose data-set id is ``source_id`` (ProcTHOR's object
+        "id"), or None when no object has it."""
+        index = self._cache.get("source_ids")
+        if index is None:
+            index = {}
+            for o in self.objects:
+                if o.source_id:
+                    index.setdefault(o.source_id, o.instance_id)
+            self._cache["source_ids"] = index
+        return index.get(source_id)
 
     def footprint(self, instance_id: int) -> np.ndarray:
         """(N, 2) int cells (row, col) under the object (at least the cell of its centre)."""

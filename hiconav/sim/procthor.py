@@ -258,7 +258,8 @@ def build_house(data: dict[str, Any], name: str, file: str, line: int | None,
                             file=file, line=line, field=f"{path}.assetId")
         iid = len(objects)
         objects.append(SimObject(iid, category_of(otype), center, size,
-                                 -math.radians(yaw_unity), otype, parent, default))
+                                 -math.radians(yaw_unity), otype, parent, default,
+                                 str(obj.get("id") or "")))
         for k, child in enumerate(obj.get("children") or []):
             add(child, f"{path}.children[{k}]", iid)
 

@@ -111,6 +111,19 @@ def test_every_objectnav_category_is_in_the_default_vocabulary(parser) -> None:
         assert parser.parse(f"find the {cat.replace('_', ' ')}").targets == (cat,)
 
 
+@pytest.mark.parametrize("text", ["where is the lavatory?", "take me to the lavatory"])
+def test_lavatory_is_a_toilet(parser, text) -> None:
+    assert parser.parse(text).targets == ("toilet",)
+
+
+@pytest.mark.parametrize("lead", ["head over to", "I need to get to", "I need to go to", "I want to go to",
+                                  "make your way to", "walk up to"])
+def test_leading_phrases_of_people_asking_to_go_somewhere_are_not_objects(parser, lead) -> None:
+    task = parser.parse(f"{lead} the wastebasket")
+    assert task.targets == ("garbage_can",)
+    assert task.attributes.get("garbage_can", ()) == ()
+
+
 def test_synonyms_follow_the_active_vocabulary() -> None:
     p = OfflineParser(("refrigerator", "couch", "potted_plant", "television"), no_similarity)
     assert p.parse("find the fridge").targets == ("refrigerator",)
