@@ -32,9 +32,16 @@ from typing import Any, Protocol
 
 import numpy as np
 
-NEXT_TO_M = 1.0  # m: planar gap between two boxes that reads "next to" / "beside"
-NEAR_M = 2.0  # m: planar gap that reads "near"
-ON_GAP_M = 0.30  # m: a box whose bottom lies this close to another's top rests on it
+from hiconav.relations import NEAR, NEXT_TO
+
+# the same gaps as the ground-truth predicates that generate described-instance episodes
+# (``hiconav.relations``), so that a description and its grounding mean one thing; memory boxes are
+# axis-aligned, so their gap is computed here directly
+NEXT_TO_M = NEXT_TO  # m: planar gap between two boxes that reads "next to" / "beside"
+NEAR_M = NEAR  # m: planar gap that reads "near"
+# m: a box whose bottom lies this close to another's top rests on it (wider than the ground truth's
+# 0.10 m: a memory box grows by a few far-off points of its object)
+ON_GAP_M = 0.30
 ROOM_DECAY_M = 2.5  # m: a room cue's weight falls by e over this planar distance
 ROOM_REACH_M = 6.0  # m: cues farther than this say nothing of an object's room
 ROOM_MIN_SCORE = 0.8  # below this evidence the room is unknown
