@@ -42,6 +42,10 @@ NEAR_M = NEAR  # m: planar gap that reads "near"
 # m: a box whose bottom lies this close to another's top rests on it (wider than the ground truth's
 # 0.10 m: a memory box grows by a few far-off points of its object)
 ON_GAP_M = 0.30
+# m: footprints this far apart still count as one above the other: a painting or TV hung above a
+# bed or sofa that stands against the same wall has its memory box on the wall's face, the
+# furniture's stops short of the wall, so their boxes from depth points rarely overlap in plan
+STACK_PAD_M = 0.30
 ROOM_DECAY_M = 2.5  # m: a room cue's weight falls by e over this planar distance
 ROOM_REACH_M = 6.0  # m: cues farther than this say nothing of an object's room
 ROOM_MIN_SCORE = 0.8  # below this evidence the room is unknown
@@ -119,9 +123,9 @@ def relation_holds(relation: str, a: BoxLike, b: BoxLike) -> bool:
     if rel == "on":
         return _centre_in_plan(a, b) and abs(float(a.box_min[2]) - float(b.box_max[2])) <= ON_GAP_M
     if rel in ("under", "below"):
-        return _plan_overlap(a, b) and float(b.box_min[2]) >= float(a.box_max[2]) - ON_GAP_M
+        return _plan_overlap(a, b, STACK_PAD_M) and float(b.box_min[2]) >= float(a.box_max[2]) - ON_GAP_M
     if rel == "above":
-        return _plan_overlap(a, b) and float(a.box_min[2]) >= float(b.box_max[2]) - ON_GAP_M
+        return _plan_overlap(a, b, STACK_PAD_M) and float(a.box_min[2]) >= float(b.box_max[2]) - ON_GAP_M
     if rel == "in":
         return _centre_in_plan(a, b, pad=0.0) and float(b.box_min[2]) - 0.1 <= float(a.box_min[2]) <= float(b.box_max[2])
     if rel == "next to":

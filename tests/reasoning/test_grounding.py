@@ -79,6 +79,15 @@ def test_on_means_resting_on_the_other_top_and_under_the_reverse():
     assert relation_holds("under", cat_bed, table) and not relation_holds("under", table, cat_bed)
 
 
+def test_a_painting_on_the_wall_above_a_bed_against_it_is_above_the_bed():
+    # the bed's box stops 0.2 m short of the wall; the painting's box lies on the wall's face
+    bed = node(1, "bed", (1.0, 1.0), (1.6, 2.0), (0.0, 0.6))
+    painting = node(2, "painting", (1.0, 2.22), (0.8, 0.04), (1.2, 1.8))
+    assert relation_holds("under", bed, painting) and relation_holds("above", painting, bed)
+    across_the_room = node(3, "painting", (1.0, 3.0), (0.8, 0.04), (1.2, 1.8))
+    assert not relation_holds("under", bed, across_the_room)
+
+
 def test_room_words_map_to_the_four_room_types():
     assert room_of("living room") == "living_room" and room_of("lounge") == "living_room"
     assert room_of("restroom") == "bathroom" and room_of("floor_lamp") is None
