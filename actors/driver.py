@@ -71,11 +71,11 @@ class DriverNode(Node):
         self.actions: list[str] = []
         self.last_command: VelocityCommand | DiscreteAction | None = None
         self._pending_frame: Any = None
+        self._reobserve = False  # the robot's last frame was invalid: observe again next tick
+        self.last_bad_frame = ""
         self.latest_wins(CommandMsg)
 
     def start(self, now: float) -> None:
-        self._reobserve = False
-        self.last_bad_frame = ""
         self._pending_frame = self._frame(lambda: self.sim.reset(self.start_pose))
         self._record()
 
@@ -129,7 +129,7 @@ class DriverNode(Node):
             if self.take(CommandMsg) is not None:  # the driver streams zero while paused
                 self._drop("paused")
             return
-        if getattr(self, "_reobserve", False) and self._pending_frame is None and self.ended is None:
+        if self._reobserve and self._pending_frame is None and self.ended is None:
             self._reobserve = False
             self._pending_frame = self._frame(self.sim.observe)
         if self._pending_frame is not None:

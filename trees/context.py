@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from hiconav.messages import GoalMsg, NavStatus, ParseRequest, StopRequest
+from hiconav.reasoning.grounding import target_relations
 from hiconav.types import Goal, Pose2D, TaskSpec
 
 
@@ -262,8 +263,6 @@ class MissionContext:
     def described(self) -> bool:
         """The instruction singles out one instance by relations on the target ("the armchair next
         to the floor lamp"): a label match then proposes nothing, the reasoning layer decides."""
-        from hiconav.reasoning.grounding import target_relations
-
         return self.task is not None and bool(target_relations(self.task.relations, self.task.targets))
 
     def _resolve(self, hyp: Any, memory: Any, objects: dict[int, Any]) -> int | None:

@@ -12,6 +12,7 @@ import json
 import os
 import shlex
 import sys
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -80,6 +81,19 @@ def _save_specs(out: Path, source: dict[str, Any], specs: list[Any]) -> None:
     (out / SOURCE_FILE).write_text(json.dumps(source, indent=2) + "\n", encoding="utf-8")
 
 
+def _reasons(errors: list[str | None]) -> dict[str, int]:
+    """{short reason: count} of the invalid episodes' errors (``sources.invalid_reason``), sorted."""
+    from hiconav.eval.sources import invalid_reason
+
+    return dict(sorted(Counter(invalid_reason(e) for e in errors if e).items()))
+
+
+def _none_valid(episodes: int, reasons: dict[str, int], hint: str = "") -> DataError:
+    listed = ", ".join(f"{k}: {v}" for k, v in reasons.items()) or "none"
+    return DataError(f"no episode of the input is valid ({episodes} episodes: {listed}){hint}",
+                     field="--houses/--maps")
+
+
 def eval(
     out: Path = typer.Option(..., "--out", help="Output folder (episodes.jsonl, summary.json, report.md, plots)."),
     houses: Path | None = typer.Option(None, "--houses", help="ProcTHOR houses FILE.jsonl.gz (episodes are generated)."),
@@ -104,7 +118,7 @@ def eval(
     from hiconav.eval.config import EvalConfig
     from hiconav.eval.presets import resolve_presets
     from hiconav.eval.runner import evaluate
-    from hiconav.eval.sources import gibson_source, invalid_reason, procthor_source, task_episode_source, validate_spec
+    from hiconav.eval.sources import gibson_source, procthor_source, task_episode_source, validate_spec
 
     if (houses is None) == (maps is None):
         raise ConfigError("give exactly one input: --houses FILE.jsonl.gz or --maps FILE.pbz2", field="--houses/--maps")
@@ -142,19 +156,14 @@ def eval(
     if dry_run:  # nothing is written: validate and count
         specs = build()
         errors = [validate_spec(spec) for spec in specs]
-        invalid: dict[str, int] = {}
-        for error in errors:
-            if error:
-                invalid[invalid_reason(error)] = invalid.get(invalid_reason(error), 0) + 1
         for spec, error in zip(specs, errors, strict=True):
             if error:
                 typer.echo(f"invalid {spec.episode_id}: {error}")
+        invalid = _reasons(errors)
         valid = sum(1 for error in errors if not error)
-        typer.echo(json.dumps({"episodes": len(specs), "valid": valid, "invalid": dict(sorted(invalid.items()))}))
+        typer.echo(json.dumps({"episodes": len(specs), "valid": valid, "invalid": invalid}))
         if valid == 0:
-            raise DataError(f"no episode of the input is valid ({len(specs)} episodes: "
-                            f"{', '.join(f'{k}: {v}' for k, v in sorted(invalid.items())) or 'none'})",
-                            field="--houses/--maps")
+            raise _none_valid(len(specs), invalid)
         return
     saved = _saved_source(Path(out))
     _check_resumable(Path(out), saved, source)
@@ -165,12 +174,7 @@ def eval(
     if not specs:
         raise DataError("the input holds no episode", field="--houses/--maps")
     if all(spec.error for spec in specs):
-        reasons: dict[str, int] = {}
-        for spec in specs:
-            reasons[invalid_reason(spec.error)] = reasons.get(invalid_reason(spec.error), 0) + 1
-        raise DataError(f"no episode of the input is valid ({len(specs)} episodes: "
-                        f"{', '.join(f'{k}: {v}' for k, v in sorted(reasons.items()))}); "
-                        "run with --dry-run to list them", field="--houses/--maps")
+        raise _none_valid(len(specs), _reasons([spec.error for spec in specs]), "; run with --dry-run to list them")
     command = "hiconav eval " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if len(sys.argv) > 2 else ""
     summary = evaluate(specs, out, config, run_info={"command": command,
                                                      "source": str(houses or maps), "episodes": len(specs)})

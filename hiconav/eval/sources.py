@@ -14,11 +14,10 @@ This module must not run episodes. The simulator (``hiconav.sim``) is imported l
 
 from __future__ import annotations
 
-import bz2
 import functools
 import gzip
 import json
-import pickle
+import math
 import zlib
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
@@ -326,18 +325,25 @@ def gibson_house_specs(maps_file: str | Path, scenes: str | None = None) -> list
     return [spec for spec in specs if _scene_of(spec) in wanted]
 
 
+def _floor_of(house_spec: str) -> str:
+    """"Scene/floor" of a Gibson house spec ("gibson:Scene/floor" or "<maps file>#Scene/floor")."""
+    return house_spec.rpartition("#")[2].removeprefix("gibson:")
+
+
 def _scene_of(house_spec: str) -> str:
-    return house_spec.rpartition("#")[2].removeprefix("gibson:").split("/")[0]
+    return _floor_of(house_spec).split("/")[0]
 
 
 @functools.lru_cache(maxsize=4)
 def _gibson_house_specs(path: Path, _mtime_ns: int) -> tuple[str, ...]:
+    from hiconav.sim.gibson import load_info  # the simulator's reader: the file is decompressed once
+
     try:
-        with bz2.open(path, "rb") as fh:
-            maps = pickle.load(fh)
-    except (OSError, EOFError, pickle.UnpicklingError, ValueError) as exc:
-        raise DataError(f"cannot read Gibson maps (bz2 pickle): {exc}", file=str(path), field="--maps") from exc
-    if not isinstance(maps, dict) or not maps:
+        maps = load_info(path)
+    except DataError as exc:
+        raise DataError(f"cannot read Gibson maps (bz2 pickle): {exc.__cause__ or exc}", file=str(path),
+                        field="--maps") from exc
+    if not maps:
         raise DataError("expected {scene: {floor: {...}}}", file=str(path), field="--maps")
     root = _data_file("gibson")
     prefix = "gibson:" if root is not None and path.resolve().parent == root else f"{path.resolve()}#"
@@ -374,6 +380,10 @@ def _habitat_groups(path: Path, maps_file: Path | None = None) -> dict[tuple[str
     if not isinstance(episodes, list):
         raise DataError("expected an object with an 'episodes' list", file=str(path), field="episodes")
     groups: dict[tuple[str, int], list[dict[str, Any]]] = {}
+    if maps_file is not None:
+        from hiconav.sim.gibson import floor_for_height, load_info
+
+        mapped = set(load_info(maps_file))
     for i, episode in enumerate(episodes):
         scene = Path(str(episode.get("scene_id", "") if isinstance(episode, dict) else "")).name.split(".")[0]
         if not scene:
@@ -383,12 +393,9 @@ def _habitat_groups(path: Path, maps_file: Path | None = None) -> dict[tuple[str
         except (TypeError, ValueError) as exc:
             raise DataError(f"bad floor_id: {exc}", file=str(path), field=f"episodes[{i}].floor_id") from exc
         height = _start_height(episode)
-        if maps_file is not None and height is not None:
-            from hiconav.sim.gibson import floor_for_height, load_info
-
-            if scene in load_info(str(maps_file)):
-                found = floor_for_height(maps_file, scene, height)
-                floor = -1 if found is None else found
+        if maps_file is not None and height is not None and scene in mapped:
+            found = floor_for_height(maps_file, scene, height)
+            floor = -1 if found is None else found
         groups.setdefault((scene, floor), []).append({"_index": i, **episode})
     return groups
 
@@ -398,7 +405,7 @@ def _start_height(episode: dict[str, Any]) -> float | None:
         height = float(episode["start_position"][1])
     except (KeyError, TypeError, ValueError, IndexError):
         return None
-    return height if height == height else None
+    return height if math.isfinite(height) else None
 
 
 def gibson_source(maps_file: str | Path, episodes: Sequence[str | Path] | None = None, *,
@@ -410,7 +417,7 @@ def gibson_source(maps_file: str | Path, episodes: Sequence[str | Path] | None =
     house_specs = gibson_house_specs(maps_file, scenes)
     if not episodes:
         return _take(_generated(house_specs, episodes_per_house, seed, limit, workers), limit)
-    by_scene = {spec.rpartition("#")[2].removeprefix("gibson:"): spec for spec in house_specs}
+    by_scene = {_floor_of(spec): spec for spec in house_specs}
     return _take(_habitat(habitat_episode_files(episodes), by_scene, Path(maps_file)), limit)
 
 
@@ -502,27 +509,28 @@ def invalid_reason(error: str) -> str:
     return "other: " + error.split(":")[0][:80]
 
 
-def validate_spec(spec: EpisodeSpec, *, radius: float = 0.18) -> str | None:
+def validate_spec(spec: EpisodeSpec) -> str | None:
     """Why ``spec`` cannot be run (an error message), or None when it can: the house loads, the
-    start lies on (or within the simulator's 0.3 m snap of) the robot's free space, and a goal's
-    success region is reachable from it. Loads the house; runs nothing."""
+    simulator can place the robot at the start (``Simulator.reset``'s rule: on the robot's free
+    space, or snapped to it from nearby), and a goal's success region is reachable from there.
+    Loads the house; renders and runs nothing."""
     if spec.error:
         return spec.error
     try:
-        import math
+        import numpy as np
 
-        from hiconav.sim.geodesic import GoalDistance, centre_free
+        from hiconav.sim.geodesic import GoalDistance
+        from hiconav.sim.simulator import Simulator
 
         house = load_house_cached(spec.house)
-        goal = GoalDistance(house, instance_ids=spec.goal_instance_ids, radius=radius)
-        free = centre_free(house, radius)
-        rc = house.nav.world_to_cell(spec.start[:2])
-        reach = 6  # cells: the simulator snaps a start to free floor within 0.3 m
-        r0, c0 = max(int(rc[0]) - reach, 0), max(int(rc[1]) - reach, 0)
-        if not house.nav.in_bounds(rc) or not free[r0:int(rc[0]) + reach + 1, c0:int(rc[1]) + reach + 1].any():
+        sim = Simulator(house)  # no renderer until a frame is asked for
+        radius, success = sim.config.robot_radius, sim.config.success_distance
+        xy = np.asarray(spec.start[:2], dtype=np.float64)
+        if not sim.is_free(xy) and sim.nearest_free(xy) is None:
             return f"start {list(spec.start[:2])} is not on the traversable area of {house.name} " \
                    "(start off the robot's free space)"
-        if not math.isfinite(goal.to_success(spec.start[:2], 1.0)):
+        goal = GoalDistance(house, instance_ids=spec.goal_instance_ids, radius=radius)
+        if not math.isfinite(goal.to_success(xy, success)):
             return f"no '{spec.target}' of {house.name} is reachable from the start {list(spec.start[:2])}"
     except Exception as exc:  # noqa: BLE001 - bad input: reported, never aborts
         return f"cannot load house or goals: {type(exc).__name__}: {exc}"

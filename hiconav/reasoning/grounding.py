@@ -217,14 +217,15 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
     others = [o for o in objects if o.id != node.id and _labels_match(o.label, obj)]
     if not others:
         return "unknown", f"no {obj} in view"
+    # the related object's own relations ("the floor lamp in the living room"), checked one level down
+    nested = [(r, o2) for s2, r, o2 in (tuple(x) for x in relations)
+              if _labels_match(s2, obj) and not _labels_match(o2, node.label)] if depth == 0 else []
     best = "fails"
     line = ""
     for other in sorted(others, key=lambda o: planar_gap(node, o)):
         if not relation_holds(rel, node, other):
             continue
-        nested = [(r, o2) for s2, r, o2 in (tuple(x) for x in relations)
-                  if _labels_match(s2, obj) and not _labels_match(o2, node.label)]
-        if depth == 0 and nested:
+        if nested:
             sub = [_one(other, r, o2, objects, relations, rooms, depth=1)[0] for r, o2 in nested]
             if "fails" in sub:
                 line = f"#{other.id} is {rel} it, but not {', '.join(f'{r} {o2}' for r, o2 in nested)}"

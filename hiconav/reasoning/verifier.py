@@ -243,7 +243,8 @@ class OfflineVerifier:
         best: tuple | None = None
         reasons: list[str] = []
         described = bool(target_relations(task.relations, task.targets))
-        rooms = infer_rooms(list(subgraph.objects)) if described else None
+        objects = list(subgraph.objects)
+        rooms = infer_rooms(objects) if described else None
         groundings: dict[int, Any] = {}
         for obj in subgraph.objects:
             score, target = self._match(obj.label, task.targets)
@@ -260,7 +261,7 @@ class OfflineVerifier:
                 reasons.append(NO_MATCH)
                 continue
             if described:
-                verdict = ground(obj, list(subgraph.objects), task.relations, task.targets, rooms)
+                verdict = ground(obj, objects, task.relations, task.targets, rooms)
                 groundings[obj.id] = verdict
                 if verdict.status != "holds":
                     reasons.append(RELATION_FAILED if verdict.status == "fails" else RELATION_UNKNOWN)

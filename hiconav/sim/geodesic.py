@@ -52,7 +52,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from hiconav.errors import DataError
-from hiconav.sim.fmm import fmm_distance
+from hiconav.sim.fmm import disk, fmm_distance
 from hiconav.sim.house import House, NavGrid
 
 if TYPE_CHECKING:
@@ -158,8 +158,6 @@ def distance_mask(house: House, radius: float) -> np.ndarray:
     key = ("distance_mask", round(radius, 6))
     mask = house._cache.get(key)
     if mask is None:
-        from hiconav.sim.fmm import disk
-
         mask = ndimage.binary_dilation(free, structure=disk(SEMEXP_DILATION_CELLS))
         mask.flags.writeable = False
         house._cache[key] = mask
@@ -271,10 +269,9 @@ class GoalDistance:
         cached = house._cache.get(key)
         if cached is None:
             if house.success_rule == "semexp":
-                edt = self._goal_edt()
-                region = edt <= round(VIEW_RADIUS / house.nav.resolution)
+                region = self.success_region(VIEW_RADIUS)
                 cached = fmm_distance(distance_mask(house, self.radius), region, house.nav.resolution)
-                cached = np.where(region, edt * house.nav.resolution, cached + VIEW_RADIUS)
+                cached = np.where(region, self._goal_edt() * house.nav.resolution, cached + VIEW_RADIUS)
             else:
                 graph = house_graph(house, self.radius)
                 foot = np.concatenate([house.footprint(i) for i in ids])

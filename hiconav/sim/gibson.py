@@ -84,13 +84,18 @@ def split_clutter(clutter: np.ndarray, res: float = RESOLUTION) -> tuple[np.ndar
     return clutter & ~furniture, furniture
 
 
+def load_info(path: str | Path) -> dict[str, Any]:
+    """The decompressed ``{scene: {floor: {sem_map, origin, floor_height}}}`` of a maps file,
+    read once per process however the path is spelled (cached on the resolved path)."""
+    return _load_info(str(Path(path).expanduser().resolve()))
+
+
 @lru_cache(maxsize=2)
-def load_info(path: str) -> dict[str, Any]:
-    """The decompressed ``{scene: {floor: {sem_map, origin, floor_height}}}`` (cached)."""
+def _load_info(path: str) -> dict[str, Any]:
     try:
         with bz2.BZ2File(path) as fh:
             info = pickle.load(fh)
-    except (OSError, EOFError, pickle.UnpicklingError) as exc:
+    except (OSError, EOFError, pickle.UnpicklingError, ValueError) as exc:
         raise DataError(f"cannot read the Gibson maps: {exc}", file=path) from exc
     if not isinstance(info, dict):
         raise DataError("expected a dict {scene: {floor: ...}}", file=path)
@@ -125,9 +130,9 @@ def habitat_yaw(quat_xyzw: np.ndarray) -> float:
     return math.atan2(r[0], r[2])
 
 
-def floor_record(data_dir: Path | str, scene: str, floor: int) -> dict[str, Any]:
-    """The record of one floor; ``data_dir`` is the data root or the maps file itself."""
-    path = str(data_dir) if str(data_dir).endswith(".pbz2") else info_path(Path(data_dir))
+def floor_record(maps_file: Path | str, scene: str, floor: int) -> dict[str, Any]:
+    """The record of one floor of a maps file."""
+    path = str(maps_file)
     info = load_info(path)
     if scene not in info:
         raise DataError(f"unknown Gibson scene '{scene}'; valid: {', '.join(sorted(info))}",
@@ -175,7 +180,7 @@ def floor_for_height(maps_file: Path | str, scene: str, height: float) -> int | 
     """The floor of ``scene`` whose ``floor_height`` is nearest the Habitat height ``height`` (m),
     within ``FLOOR_TOLERANCE`` (SemExp's ``floor_thr``, 0.5 m); None when no floor is that close
     (the position lies on a floor the maps file does not hold)."""
-    floors = load_info(str(maps_file)).get(scene) or {}
+    floors = load_info(maps_file).get(scene) or {}
     best, gap = None, FLOOR_TOLERANCE
     for index in sorted(floors):
         rec = floors[index]
@@ -189,7 +194,7 @@ def floor_for_height(maps_file: Path | str, scene: str, height: float) -> int | 
 
 def floor_heights(maps_file: Path | str, scene: str) -> str:
     """"0 at 0.00 m, 1 at 3.10 m": the floors of ``scene`` for messages."""
-    floors = load_info(str(maps_file)).get(scene) or {}
+    floors = load_info(maps_file).get(scene) or {}
     return ", ".join(f"{k} at {float(v.get('floor_height', 0.0)):.2f} m" for k, v in sorted(floors.items())
                      if isinstance(v, dict)) or "none"
 
@@ -222,7 +227,7 @@ def load_gibson_file(path: Path | str, scene: str, floor: int, *, name: str | No
     """Build the ``House`` of one floor of any SemExp / L3MVN maps file (``*_info.pbz2``), named
     ``<path>#<scene>/<floor>`` unless ``name`` is given."""
     path = Path(path)
-    rec = floor_record(str(path), scene, floor)
+    rec = floor_record(path, scene, floor)
     sem = np.asarray(rec["sem_map"]) > 0
     origin = np.asarray(rec["origin"], dtype=np.float64) / 100.0  # (x_w, y_w) = (z_h, x_h)
     floor_height = float(rec.get("floor_height", 0.0))
