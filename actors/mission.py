@@ -15,6 +15,7 @@ from typing import Any
 
 from hiconav.actors.node import Node
 from hiconav.actors.runtime import NodeActor
+from hiconav.decisions.config import DecisionsConfig
 from hiconav.trees.context import MissionContext
 from hiconav.trees.mission_tree import MissionTree
 
@@ -49,7 +50,8 @@ class MissionNode(Node):
     def __init__(self, tree: str | Path, instruction: str, *, rate_hz: float = 10.0,
                  blackboard: dict[str, Any] | None = None, success_distance: float = 1.0, verify: bool = True,
                  use_memory_labels: bool = True, reasoning: bool = True, record_tree: bool = False,
-                 requalify_observations: int = 3, remap_area_m2: float = 1.0) -> None:
+                 requalify_observations: int = 3, remap_area_m2: float = 1.0,
+                 decisions: DecisionsConfig | None = None) -> None:
         super().__init__(rate_hz)
         self.tree_source = tree
         self.instruction = instruction
@@ -60,6 +62,7 @@ class MissionNode(Node):
         self.reasoning = reasoning
         self.requalify_observations = requalify_observations
         self.remap_area_m2 = remap_area_m2
+        self.decisions = decisions if decisions is not None else DecisionsConfig()
         self.record_tree = record_tree
         self._now = 0.0
         self.context: MissionContext | None = None
@@ -87,7 +90,7 @@ class MissionNode(Node):
                                       success_distance=self.success_distance, verify=self.verify,
                                       use_memory_labels=self.use_memory_labels, reasoning=self.reasoning,
                                       requalify_observations=self.requalify_observations,
-                                      remap_area_m2=self.remap_area_m2)
+                                      remap_area_m2=self.remap_area_m2, decisions=self.decisions)
         self.tree = MissionTree(self.tree_source, self.context, self.blackboard)
 
     def stop(self, now: float) -> None:

@@ -142,6 +142,7 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
     ``robot``: a simulator-shaped real-time robot (``drivers.adapters.SimulatorFacade``) that the
     driver actor drives instead of a new ``Simulator`` (real-time clock only).
     """
+    from hiconav.decisions.config import DecisionsConfig
     from hiconav.actors.control import ControlNode
     from hiconav.actors.driver import DriverNode
     from hiconav.actors.exploration import ExplorationNode
@@ -242,7 +243,9 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
                           success_distance=sim_cfg.success_distance, verify=cfg.verify,
                           use_memory_labels=cfg.use_memory_labels, reasoning=cfg.reasoning,
                           requalify_observations=cfg.requalify_observations,
-                          remap_area_m2=cfg.remap_area_m2, record_tree=record is not None or spawn)
+                          remap_area_m2=cfg.remap_area_m2,
+                          decisions=area_config(DecisionsConfig, overrides, "decisions"),  # type: ignore[arg-type]
+                          record_tree=record is not None or spawn)
     nodes = [driver, perception, memory, reasoning, exploration, control, mission]
     for path, kwargs in cfg.extra_actors.items():
         from hiconav.actors.node import Node

@@ -30,6 +30,7 @@ AREAS: dict[str, str] = {
     "exploration": "hiconav.exploration.config:ExplorationConfig",
     "reasoning": "hiconav.reasoning.config:ReasoningConfig",
     "mission": "hiconav.mission:MissionConfig",
+    "decisions": "hiconav.decisions.config:DecisionsConfig",
 }
 
 #: shipped as package data of ``hiconav.config`` (the top-level config/ folder in a checkout)
@@ -189,3 +190,28 @@ def effective_settings(overrides: dict[str, Any] | None = None) -> dict[str, Any
     """Every section with defaults and overrides applied, as plain data (for printing)."""
     models = validate(dict(overrides or {}))
     return {area: model.model_dump(mode="json") for area, model in models.items()}
+
+
+def describe_settings(overrides: dict[str, Any] | None = None) -> list[str]:
+    """One line per documented setting (a field with a description), every section:
+    ``area.key = value  [min, max]  reason``; the value is the effective one."""
+    models = validate(dict(overrides or {}))
+    out: list[str] = []
+
+    def walk(model: BaseModel, prefix: str) -> None:
+        for key, info in type(model).model_fields.items():
+            value = getattr(model, key)
+            if isinstance(value, BaseModel):
+                walk(value, f"{prefix}.{key}")
+                continue
+            if not info.description:
+                continue
+            lo = next((m.ge for m in info.metadata if getattr(m, "ge", None) is not None), None)
+            hi = next((m.le for m in info.metadata if getattr(m, "le", None) is not None), None)
+            bounds = f"  [{'' if lo is None else lo}, {'' if hi is None else hi}]" if lo is not None or hi is not None \
+                else ""
+            out.append(f"{prefix}.{key} = {value!r}{bounds}  {info.description}")
+
+    for area, model in models.items():
+        walk(model, area)
+    return out

@@ -234,7 +234,7 @@ class _Parser:
                     raise _err(f"{type_name}.{key}: {problem}", file, value_node, key)
                 params[key] = value
         for key, decl in spec.params.items():
-            if key not in params:
+            if key not in params and not decl.from_settings:
                 if decl.required:
                     raise _err(f"{type_name} requires parameter {key!r} ({decl.type.__name__})",
                                file, type_node, key)

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from hiconav.decisions.config import DecisionsConfig
 from hiconav.messages import GoalMsg, NavStatus, ParseRequest, StopRequest
 from hiconav.reasoning.grounding import target_relations
 from hiconav.types import Goal, Pose2D, TaskSpec
@@ -64,6 +65,8 @@ class MissionContext:
     # the reasoning layer verifies subgraphs: for a described instance (relations on the target)
     # only its verdict proposes candidates; without it (the no_reasoning ablation) labels do
     reasoning: bool = True
+    # decisions.*: the thresholds the behaviours and the decision modules read
+    decisions: DecisionsConfig = field(default_factory=DecisionsConfig)
     verify: bool = True  # False: VerifyTarget accepts the candidate as is (the 'no_verify' ablation)
     task: TaskSpec | None = None
     world: Any = None  # WorldSnapshot

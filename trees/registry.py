@@ -19,6 +19,8 @@ from typing import Any
 from hiconav.registry import Registry
 
 REQUIRED: Any = object()  # sentinel: the parameter has no default
+#: sentinel default: the value comes from the mission's ``decisions.<section>`` settings at tick time
+FROM_SETTINGS: Any = object()
 
 #: ``{key}`` (BehaviorTree.CPP's blackboard-port syntax): the value is read from the mission's
 #: blackboard at tick time instead of being a literal.
@@ -47,6 +49,10 @@ class Param:
     @property
     def required(self) -> bool:
         return self.default is REQUIRED
+
+    @property
+    def from_settings(self) -> bool:
+        return self.default is FROM_SETTINGS
 
     def check(self, value: Any) -> str | None:
         """Return why ``value`` is not acceptable, or None when it is."""
@@ -88,6 +94,37 @@ class NodeSpec:
 BEHAVIOURS: Registry[NodeSpec] = Registry("behaviour")
 
 
+def settings_params(section: str | None) -> dict[str, Param]:
+    """One ``Param`` per field of the ``decisions.<section>`` settings (type, range, reason), with
+    the ``FROM_SETTINGS`` default: a mission tree may override a field for one node, checked
+    against the field's own declaration, and a node that does not reads the mission's settings."""
+    if not section:
+        return {}
+    from typing import Literal, get_args, get_origin
+
+    from hiconav.decisions.config import DecisionsConfig
+
+    model = DecisionsConfig.model_fields[section].annotation
+    out: dict[str, Param] = {}
+    for key, info in model.model_fields.items():  # type: ignore[union-attr]
+        annotation, choices = info.annotation, None
+        if get_origin(annotation) is Literal:
+            choices = get_args(annotation)
+            annotation = type(choices[0])
+        elif get_origin(annotation) is list:
+            annotation = list
+        lo = next((m.ge for m in info.metadata if getattr(m, "ge", None) is not None), None)
+        hi = next((m.le for m in info.metadata if getattr(m, "le", None) is not None), None)
+        out[key] = Param(annotation, FROM_SETTINGS, minimum=lo, maximum=hi, choices=choices,
+                         doc=f"{info.description} (default: decisions.{section}.{key})")
+    return out
+
+
+def behaviour_params(cls: type) -> dict[str, Param]:
+    """A behaviour class's YAML parameters: its own ``PARAMS`` and its settings section's fields."""
+    return {**settings_params(getattr(cls, "SETTINGS", None)), **dict(getattr(cls, "PARAMS", {}))}
+
+
 def register_behaviour(name: str | None = None) -> Callable[[type], type]:
     """Class decorator registering a leaf behaviour (a ``MissionBehaviour`` subclass) by name.
 
@@ -97,7 +134,7 @@ def register_behaviour(name: str | None = None) -> Callable[[type], type]:
 
     def decorator(cls: type) -> type:
         key = name or cls.__name__
-        BEHAVIOURS.add(key, NodeSpec(key, "leaf", cls, dict(getattr(cls, "PARAMS", {})),
+        BEHAVIOURS.add(key, NodeSpec(key, "leaf", cls, behaviour_params(cls),
                                      (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else ""))
         return cls
 
@@ -115,7 +152,7 @@ def spec_for(name: str, *, field: str | None = None) -> NodeSpec:
     if isinstance(item, NodeSpec):
         return item
     if isinstance(item, type):  # user extension by import path: a leaf behaviour class
-        return NodeSpec(name, "leaf", item, dict(getattr(item, "PARAMS", {})), (item.__doc__ or "").strip())
+        return NodeSpec(name, "leaf", item, behaviour_params(item), (item.__doc__ or "").strip())
     from hiconav.errors import ConfigError
 
     raise ConfigError(f"{name!r} is not a behaviour class", field=field)

@@ -73,13 +73,34 @@ def test_subtree_is_included_by_name_and_recorded():
 
 def test_defaults_fill_missing_optional_parameters(tmp_path: Path):
     f = tmp_path / "m.yaml"
-    f.write_text("root:\n  Explore: {max_idle_s: 2}\n")
+    f.write_text("root:\n  Sequence:\n    children:\n      - Stop: {}\n      - Explore: {max_idle_s: 2}\n")
     definition = load_tree(f)
-    assert definition.root.params == {"max_idle_s": 2, "goal_tolerance": 0.3, "switch_distance": 0.5, "look_turns": 4,
-                                      "spent_radius": 0.4, "spent_after_s": 0.5,
-                                      "start_look_turns": 0, "push_through": True, "push_radius": 1.5,
-                                      "push_m": 0.6, "push_s": 6.0, "stall_s": 8.0,
-                                      "squeeze": True}
+    assert definition.root.children[0].params == {"reason": "mission complete"}
+    # a settings field is a node parameter only where the tree sets it: the rest are the mission's
+    assert definition.root.children[1].params == {"max_idle_s": 2}
+
+
+def test_a_node_reads_its_settings_section_and_its_own_overrides(tmp_path: Path):
+    from hiconav.decisions.config import DecisionsConfig, ExploreSettings
+    from hiconav.trees.context import MissionContext
+
+    f = tmp_path / "m.yaml"
+    f.write_text("root:\n  Explore: {max_idle_s: 2}\n")
+    root, _ = build_tree(f)
+    ctx = MissionContext("find the bed", clock=lambda: 0.0,
+                         decisions=DecisionsConfig(explore=ExploreSettings(look_turns=7, max_idle_s=9.0)))
+    root.setup(context=ctx)
+    assert root.param("look_turns") == 7  # the mission's decisions.explore
+    assert root.param("max_idle_s") == 2  # the tree's own value for this node
+    assert root.settings.max_idle_s == 2 and root.settings.look_turns == 7
+
+
+def test_a_settings_override_in_a_tree_is_checked_against_the_field(tmp_path: Path):
+    f = tmp_path / "m.yaml"
+    f.write_text("root:\n  Approach:\n    distance: 9.0\n")
+    with pytest.raises(TreeError, match="above the maximum 5.0") as info:
+        load_tree(f)
+    assert info.value.line == 3
 
 
 def test_user_behaviour_by_import_path(tmp_path: Path):

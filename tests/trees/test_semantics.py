@@ -9,6 +9,7 @@ from pathlib import Path
 
 import py_trees
 import pytest
+from hiconav.decisions.config import DecisionsConfig, ExploreSettings
 from hiconav.trees import BlackboardError, MissionContext
 from hiconav.trees.mission_tree import MissionTree
 
@@ -34,7 +35,12 @@ def _write(tmp_path: Path, text: str) -> Path:
     return f
 
 
+# the tests look at one decision at a time: no look-around at the start unless a test asks for it
+NO_START_LOOK = DecisionsConfig(explore=ExploreSettings(start_look_turns=0))
+
+
 def _ctx(clock: Clock, **kw) -> MissionContext:
+    kw.setdefault("decisions", NO_START_LOOK)
     ctx = MissionContext(instruction="find the bed", clock=clock, **kw)
     ctx.task = TaskSpec("find the bed", ("bed",))
     ctx.world = world(Pose2D(2.0, 2.0, 0.0))
@@ -407,7 +413,7 @@ def test_parse_instruction_reads_the_blackboard_and_waits_for_the_task(tmp_path)
 
 
 def test_blackboard_value_of_the_wrong_type_names_file_and_line(tmp_path):
-    ctx = MissionContext(instruction="", clock=Clock())
+    ctx = MissionContext(instruction="", clock=Clock(), decisions=NO_START_LOOK)
     f = _write(tmp_path, "root:\n  Explore:\n    max_idle_s: '{patience}'\n")
     tree = MissionTree(f, ctx, blackboard={"patience": "long"})
     ctx.plan = plan()
@@ -614,7 +620,7 @@ def test_approach_cell_prefers_the_front_of_an_objects_middle_over_its_near_end(
     """A painting 1 m long on a wall at x = 5: the plain nearest cell lies off its lower end (a
     grazing view, not a ground-truth view point); with the centre weight the cell faces its middle."""
     import numpy as np
-    from hiconav.trees.behaviours.viewing import approach_cell
+    from hiconav.decisions.geometry import approach_cell
 
     from .fakes import open_grid
 
@@ -635,7 +641,7 @@ def test_approach_cell_judges_walls_at_the_cameras_height_when_told_it():
     wall and it drove 1.2 m to the sofa's middle. With the camera's height (0.88 m) and the
     sofa's top (0.85 m) the cabinet hides nothing; a wall (no height recorded) still does."""
     import numpy as np
-    from hiconav.trees.behaviours.viewing import approach_cell
+    from hiconav.decisions.geometry import approach_cell
 
     from .fakes import open_grid
 
@@ -659,7 +665,7 @@ def test_approach_cell_on_a_settle_ring_is_the_one_nearest_the_object():
     to itself, 0.96-1.06 m from the box, where the box's error decides success; with the box
     weight it takes the nearest free cell to the object (here 0.85 m out)."""
     import numpy as np
-    from hiconav.trees.behaviours.viewing import approach_cell
+    from hiconav.decisions.geometry import approach_cell
 
     from .fakes import open_grid
 
@@ -957,7 +963,7 @@ def test_anchor_sees_needs_the_point_in_the_image_and_no_box_in_the_way():
     """A tv 1.9 m up is above the vertical field of view of a camera 0.88 m up and 1 m away; a
     vase behind a chair is hidden; from 3 m away the tv is in view."""
     import numpy as np
-    from hiconav.trees.behaviours.viewing import anchor_sees
+    from hiconav.decisions.geometry import anchor_sees
 
     cam = anchor(1, Pose2D(0.0, 0.0, 0.0), height=0.88)
     assert anchor_sees(cam, np.array([2.0, 0.0, 0.9]))
@@ -997,7 +1003,7 @@ def test_verify_does_not_count_hidden_frames_and_moves_to_a_cell_that_sees(tmp_p
     moved = [g for g in goals if g.kind == "approach"]
     assert moved, goals
     g = moved[-1]
-    from hiconav.trees.behaviours.viewing import segments_blocked
+    from hiconav.decisions.geometry import segments_blocked
 
     assert not segments_blocked(np.array([[g.x, g.y, 0.4]]), np.array([5.0, 5.0, 0.4]),
                                 chair.box_min[None, :] + [0.05, 0.05, 0.0], chair.box_max[None, :] - [0.05, 0.05, 0.0])[0]
@@ -1070,7 +1076,7 @@ def test_approach_goes_to_its_cell_even_when_it_starts_within_the_distance(tmp_p
 def test_wall_clear_sees_past_known_furniture_but_not_past_walls():
     """The 2D line of sight from an approach cell: occupied cells inside memory objects' boxes
     (a table) are see-through, the rest (a wall) are not."""
-    from hiconav.trees.behaviours.viewing import wall_clear
+    from hiconav.decisions.geometry import wall_clear
 
     from .fakes import open_grid
 

@@ -3,29 +3,13 @@
 Importing this package registers them in ``hiconav.trees.registry.BEHAVIOURS``.
 """
 
-from hiconav.trees.behaviours import composites, mission  # noqa: F401  (registration)
+from hiconav.decisions.geometry import approach_cell
+from hiconav.trees.behaviours import approach, composites, explore, mission, verify  # noqa: F401  (registration)
+from hiconav.trees.behaviours.approach import Approach
 from hiconav.trees.behaviours.base import MissionBehaviour
-from hiconav.trees.behaviours.mission import (
-                                              Approach,
-                                              Explore,
-                                              HealthOk,
-                                              ParseInstruction,
-                                              ReturnToStart,
-                                              Stop,
-                                              TargetConfirmed,
-                                              VerifyTarget,
-)
-from hiconav.trees.behaviours.viewing import approach_cell
+from hiconav.trees.behaviours.explore import Explore
+from hiconav.trees.behaviours.mission import HealthOk, ParseInstruction, ReturnToStart, Stop, TargetConfirmed
+from hiconav.trees.behaviours.verify import VerifyTarget
 
-__all__ = [
-                                              "Approach",
-                                              "Explore",
-                                              "HealthOk",
-                                              "MissionBehaviour",
-                                              "ParseInstruction",
-                                              "ReturnToStart",
-                                              "Stop",
-                                              "TargetConfirmed",
-                                              "VerifyTarget",
-                                              "approach_cell",
-]
+__all__ = ["Approach", "Explore", "HealthOk", "MissionBehaviour", "ParseInstruction", "ReturnToStart", "Stop",
+           "TargetConfirmed", "VerifyTarget", "approach_cell"]

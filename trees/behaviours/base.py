@@ -15,7 +15,7 @@ import py_trees
 from hiconav.trees.builder import BlackboardRef
 from hiconav.trees.context import MissionContext
 from hiconav.trees.errors import BlackboardError, TreeError
-from hiconav.trees.registry import Param
+from hiconav.trees.registry import Param, behaviour_params
 
 Status = py_trees.common.Status
 
@@ -24,6 +24,9 @@ class MissionBehaviour(py_trees.behaviour.Behaviour):
     """A leaf of a mission tree; ``PARAMS`` declares its YAML parameters, ``WRITES`` its outputs."""
 
     PARAMS: dict[str, Param] = {}
+    #: the ``decisions.<section>`` settings this behaviour reads (None: none); each of their fields
+    #: is also a parameter a mission tree may set for this node (``param(key)``)
+    SETTINGS: str | None = None
     WRITES: tuple[str, ...] = ()
     READS: tuple[str, ...] = ()
 
@@ -61,6 +64,10 @@ class MissionBehaviour(py_trees.behaviour.Behaviour):
 
     # -- parameters ------------------------------------------------------------------------------
     def param(self, key: str) -> Any:
+        """The node's value of ``key``: its YAML literal, the blackboard entry it names, or, for a
+        settings field the tree does not set, the mission's ``decisions.<SETTINGS>.<key>``."""
+        if key not in self._params and self.SETTINGS is not None:
+            return getattr(getattr(self.context.decisions, self.SETTINGS), key)
         value = self._params[key]
         if not isinstance(value, BlackboardRef):
             return value
@@ -70,11 +77,19 @@ class MissionBehaviour(py_trees.behaviour.Behaviour):
             raise BlackboardError(f"{type(self).__name__}.{key} reads blackboard key {value.key!r}, which is not set",
                                   file=file or None, line=int(line) if line.isdigit() else None, field=key)
         got = self.bb.get(value.key)
-        problem = self.PARAMS[key].check(got)
+        problem = behaviour_params(type(self))[key].check(got)
         if problem is not None:
             raise BlackboardError(f"{type(self).__name__}.{key} from blackboard key {value.key!r}: {problem}",
                                   file=file or None, line=int(line) if line.isdigit() else None, field=key)
         return got
+
+    @property
+    def settings(self) -> Any:
+        """This node's ``decisions.<SETTINGS>`` section: the mission's, with what the tree sets for
+        this node applied (blackboard references read now)."""
+        section = getattr(self.context.decisions, self.SETTINGS)
+        own = {k: self.param(k) for k in self._params if k in type(section).model_fields}
+        return section.model_copy(update=own) if own else section
 
     def write(self, key: str, value: Any) -> None:
         self.bb.set(key, value, overwrite=True)

@@ -1,0 +1,180 @@
+"""decisions.*: every threshold of the mission's decisions, one typed field each.
+
+The decision modules of ``hiconav/decisions/`` (frontier following, view planning, target
+confirmation, approach) and the behaviours that poll them read their numbers from here, and
+from nowhere else: each field has its default, its range and a one-line reason, and
+``hiconav config --describe`` lists them. A mission tree may override a field for one node
+(``Approach: {distance: 0.9}``), checked against the same field; the shipped trees set none, so
+a ``--config`` file or ``--set decisions.approach.distance=0.9`` changes what the mission does.
+
+The defaults were chosen on ProcTHOR train houses and the Gibson tune floors (README "Results").
+This module holds data only.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from hiconav.limits import MAX_DURATION_S
+
+
+def _f(default: Any, reason: str, ge: float | None = None, le: float | None = None, **kw: Any) -> Any:
+    """A field with its default, its inclusive range and its one-line reason."""
+    return Field(default, ge=ge, le=le, description=reason, **kw)
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+
+class ParseSettings(_Section):
+    """ParseInstruction: waiting for the reasoning layer's decomposition."""
+
+    timeout_s: float = _f(60.0, "no task from the reasoning layer in this long: the mission fails", 0.0,
+                          MAX_DURATION_S)
+
+
+class TargetSettings(_Section):
+    """TargetConfirmed: what makes a candidate worth verifying."""
+
+    min_confidence: float = _f(0.0, "candidates scored below this are not taken up", 0.0, 1.0)
+    min_observations: int = _f(1, "candidates observed fewer times are not taken up", 1, 1000)
+
+
+class ExploreSettings(_Section):
+    """Explore: following the WTRP order of frontiers (``hiconav.decisions.frontiers``)."""
+
+    max_idle_s: float = _f(15.0, "no frontier for this long: exploration fails (the map is explored out)", 0.0,
+                           MAX_DURATION_S)
+    goal_tolerance: float = _f(0.3, "a frontier viewpoint is reached within this (m)", 0.05, 5.0)
+    switch_distance: float = _f(0.5, "re-send a frontier goal whose viewpoint moved this far (m)", 0.0, 10.0)
+    look_turns: int = _f(4, "quarter turns in place per spot when no frontier is known", 0, 100)
+    look_spot_m: float = _f(1.0, "look_turns count anew once the robot is this far from where it last looked (m)",
+                            0.0, 100.0)
+    start_look_turns: int = _f(4, "quarter turns in place at the mission's start: the camera sees 79 degrees, "
+                                  "so the start room is otherwise known in one direction only", 0, 100)
+    spent_radius: float = _f(0.4, "a frontier viewpoint this near a reached one that did not clear its frontier "
+                                  "is spent (m)", 0.0, 5.0)
+    spent_after_s: float = _f(0.5, "judge a reached viewpoint on plans made this long after the visit", 0.0, 60.0)
+    push_through: bool = _f(True, "drive once into a nearby frontier whose viewpoint did not clear it, as a "
+                                  "person steps into a doorway")
+    push_radius: float = _f(1.5, "push only into spent frontiers whose centroid is this near the robot (m)",
+                            0.0, 10.0)
+    push_m: float = _f(0.6, "the push goal lies this far beyond the centroid (m)", 0.0, 5.0)
+    push_s: float = _f(6.0, "clock seconds a push may take before it counts as blocked", 0.1, 600.0)
+    stall_s: float = _f(8.0, "a frontier goal the robot came no nearer to (by progress_m) for this long is "
+                             "skipped: a passage the map shows open that the robot does not fit", 0.1, 600.0)
+    progress_m: float = _f(0.25, "coming this much nearer a goal is progress (stall and idle clocks, m)",
+                           0.01, 5.0)
+    squeeze: bool = _f(True, "with every frontier failed, try each once more through unknown floor on the "
+                             "navigator's thinner masks before giving up")
+
+
+class VerifySettings(_Section):
+    """VerifyTarget: where to stand to look at a candidate (``hiconav.decisions.viewing``) and what
+    evidence confirms it (``hiconav.decisions.confirmation``)."""
+
+    verify_distance: float = _f(1.5, "the candidate is judged from within this of its footprint (m)", 0.3, 10.0)
+    view_margin: float = _f(0.35, "view cells lie this far inside verify_distance (m)", 0.0, 5.0)
+    fov_spare_deg: float = _f(8.0, "the view ring is far enough for the candidate's centre to be this far inside "
+                                   "the vertical field of view", 0.0, 45.0)
+    max_view_ring: float = _f(4.0, "the view ring widens for high or low objects up to this (m)", 0.3, 20.0)
+    min_fresh_views: int = _f(2, "frames in view that observed the candidate needed to confirm it", 0, 100)
+    min_detection_rate: float = _f(0.5, "fresh views per frame with the candidate in view needed to confirm it",
+                                   0.0, 1.0)
+    max_view_frames: int = _f(8, "frames in view after which a rarely detected candidate is rejected", 1, 10000)
+    unseen_view_frames: int = _f(4, "frames in view without a single detection after which a candidate observed "
+                                    "at most unseen_max_observations times is rejected", 1, 10000)
+    unseen_max_observations: int = _f(2, "candidates observed more often get the full max_view_frames", 0, 10000)
+    min_confidence: float = _f(0.3, "a confirmed candidate scored below this is deferred", 0.0, 1.0)
+    confident_observations: int = _f(10, "nodes observed this often pass min_confidence: detectors score small "
+                                         "objects low in every frame", 1, 100000)
+    view_ray_weight: float = _f(2.0, "1 m nearer the line the candidate was seen along is worth this many m more "
+                                     "to drive (0: no preference)", 0.0, 100.0)
+    timeout_s: float = _f(60.0, "no verdict in this long: the candidate is deferred", 0.1, MAX_DURATION_S)
+    support_margin: float = _f(0.15, "target-labelled nodes whose box overlaps the candidate's grown by this "
+                                     "support it (m)", 0.0, 2.0)
+    defer_s: float = _f(30.0, "a deferred candidate waits this long (clock s)", 0.0, MAX_DURATION_S)
+    max_deferrals: int = _f(2, "deferrals after which a candidate is rejected for good", 1, 100)
+    reposition_after: int = _f(4, "frames that could not show the candidate before trying another view cell",
+                               1, 1000)
+    view_cells: int = _f(3, "view cells tried before the candidate is deferred as hidden", 1, 100)
+    glance_deg: float = _f(35.0, "glances alternate this far left and right of facing the candidate: apart by "
+                                 "more than the memory's anchor gate, so each glance adds a frame", 0.0, 90.0)
+    closer_moves: int = _f(2, "with no view cell on the map, drive toward the candidate this many times before "
+                              "deferring it (0: defer at once)", 0, 100)
+    closer_min_gain: float = _f(1.0, "a closer cell lies this much nearer the candidate's box than the robot (m)",
+                                0.1, 10.0)
+    closer_box_weight: float = _f(4.0, "for a closer cell, 1 m nearer the box is worth this many m more to drive",
+                                  0.0, 100.0)
+    unknown_moves: int = _f(1, "with no view cell reachable on the known map and no closer cell, head for a view "
+                               "cell through unknown floor this many times before deferring (0: never)", 0, 100)
+    unknown_min_observations: int = _f(3, "only candidates observed this often head through unknown floor: the "
+                                          "way is a guess, not worth one for a one-frame box", 0, 100000)
+    switch_margin: float = _f(1.0, "on the way to the candidate, verify instead a candidate that comes this much "
+                                   "nearer the robot (m; 0: never switch)", 0.0, 100.0)
+    max_switches: int = _f(3, "switches to a nearer candidate per verification: two candidates must not trade "
+                              "places for ever", 0, 100)
+    near_view_distance: float = _f(0.6, "a frame whose camera stood this near the candidate's box and detected "
+                                        "the target's label without placing it in 3D (no depth that near) counts "
+                                        "as a fresh view (0: never)", 0.0, 5.0)
+    stall_s: float = _f(6.0, "a view cell the robot came no nearer to (by 0.25 m) for this long counts as failed",
+                        0.1, 600.0)
+    stall_near: float = _f(0.35, "within this of its view cell the robot is there, glancing about (m)", 0.0, 5.0)
+
+
+class ApproachSettings(_Section):
+    """Approach: the final ring, the straight-in step and the creep (``hiconav.decisions.approach``)."""
+
+    distance: float = _f(0.85, "stop this near the target's box: 0.15 m inside the 1 m success distance for the "
+                               "box's error", 0.1, 5.0)
+    inner_margin: float = _f(0.0, "the first ring tried lies this far inside the distance (m)", 0.0, 5.0)
+    settle_rings: list[float] = _f([1.0, 1.25, 1.5, 2.0], "wider rings to settle on, up to max_distance, when "
+                                                           "furniture leaves no free cell within the distance")
+    max_distance: float = _f(1.5, "settle this far at most when nothing closer is reachable (m)", 0.1, 5.0)
+    settle_box_weight: float = _f(4.0, "on a ring wider than distance, 1 m nearer the object's box is worth this "
+                                       "many m more to drive", 0.0, 100.0)
+    centre_weight: float = _f(0.9, "1 m nearer the footprint's centre is worth this many m more to drive (below "
+                                   "1: of the cells in line with the centre, the nearest)", 0.0, 100.0)
+    facing_tolerance_deg: float = _f(35.0, "done only when facing the target within this", 1.0, 180.0)
+    arrive_radius: float = _f(0.3, "done only this near the approach cell, when one was sent (m)", 0.0, 5.0)
+    max_attempts: int = _f(4, "approach cells tried before the target is deferred", 1, 50)
+    timeout_s: float = _f(120.0, "no arrival in this long: the target is deferred", 0.1, MAX_DURATION_S)
+    defer_s: float = _f(30.0, "an unreachable target waits this long (clock s)", 0.0, MAX_DURATION_S)
+    creep: bool = _f(True, "settled beyond the distance: creep toward the object through floor the map does not "
+                           "know before stopping")
+    creep_s: float = _f(3.0, "clock seconds a creep may take (blocked by clutter it would rock on)", 0.1, 600.0)
+    measure: Literal["box", "points"] = _f("box", "how far the robot is from the object: its memory box, or a "
+                                                  "low quantile of its points' planar distances ('points')")
+    points_quantile: float = _f(0.02, "with measure 'points', a node's points nearer than this quantile are its "
+                                      "noise", 0.0, 0.5)
+    straight_within: float = _f(0.5, "this little beyond the distance, step straight in toward the box when the "
+                                     "way and the view from the ring are clear (0: always a ring cell)", 0.0, 5.0)
+    stall_s: float = _f(6.0, "an approach cell the robot came no nearer to (by 0.25 m) for this long counts as "
+                             "failed", 0.1, 600.0)
+
+
+class ReturnSettings(_Section):
+    """ReturnToStart: going back to the pose where the mission started."""
+
+    tolerance: float = _f(0.5, "back at the start within this (m)", 0.05, 5.0)
+    timeout_s: float = _f(300.0, "not back in this long: the behaviour fails", 0.1, MAX_DURATION_S)
+
+
+class DecisionsConfig(BaseModel):
+    """decisions.*: one section per decision (each behaviour names the section it reads)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+    parse: ParseSettings = Field(default_factory=ParseSettings)
+    target: TargetSettings = Field(default_factory=TargetSettings)
+    explore: ExploreSettings = Field(default_factory=ExploreSettings)
+    verify: VerifySettings = Field(default_factory=VerifySettings)
+    approach: ApproachSettings = Field(default_factory=ApproachSettings)
+    return_home: ReturnSettings = Field(default_factory=ReturnSettings)
+
+
+__all__ = ["ApproachSettings", "DecisionsConfig", "ExploreSettings", "ParseSettings", "ReturnSettings",
+           "TargetSettings", "VerifySettings"]

@@ -1,0 +1,105 @@
+"""Shared machinery of VerifyTarget and Approach: a free cell near a candidate's footprint, the
+goal to it facing the candidate, and the stall clock (no progress toward a goal). Pure polling:
+nothing here blocks or talks to an actor.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from hiconav.decisions.cells import camera_of, cell_near, furniture_boxes, wall_heights
+from hiconav.decisions.progress import StallClock
+from hiconav.decisions.geometry import facing as _facing
+from hiconav.trees.behaviours.base import MissionBehaviour, Status
+from hiconav.trees.context import Candidate
+from hiconav.types import Goal
+
+
+def _stalled_toward(behaviour: MissionBehaviour, goal: np.ndarray | None, limit_s: float,
+                    near: float = 0.35, progress: float = 0.25) -> bool:
+    """True when, with a goal in flight (``behaviour._seq``), the robot has come no nearer to
+    ``goal`` (``StallClock``) for ``limit_s`` clock seconds; the clock is ``behaviour._stall``,
+    kept across activations until the behaviour resets it with a new goal."""
+    pose = behaviour.context.pose
+    if pose is None or goal is None or getattr(behaviour, "_seq", None) is None:
+        return False
+    clock = _stall_clock(behaviour)
+    return clock.stalled(math.hypot(pose.x - goal[0], pose.y - goal[1]), behaviour.context.now(), limit_s,
+                         near, progress)
+
+
+def _stall_clock(behaviour: MissionBehaviour) -> StallClock:
+    clock = getattr(behaviour, "_stall", None)
+    if clock is None:
+        clock = behaviour._stall = StallClock()  # type: ignore[attr-defined]
+    return clock
+
+
+class _GoToObject(MissionBehaviour):
+    """Shared machinery: choose a free cell near the candidate's footprint and go there facing it."""
+
+    READS = ("target",)
+    def _centre_weight(self) -> float:
+        """approach_cell's weight on a cell's distance to the footprint's centre (see Approach)."""
+        return 0.0
+
+    def _prefer_weight(self) -> float:
+        """approach_cell's weight on a cell's distance to ``_preferred_xy`` (see VerifyTarget)."""
+        return 0.0
+
+    def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
+        """A point the approach cell should lie near, or None (no preference)."""
+        return None
+
+    def _sight(self, cand: Candidate) -> tuple[np.ndarray, float, np.ndarray, np.ndarray] | None:
+        """approach_cell's ``sight`` argument, or None: cells need not see the candidate."""
+        return None
+
+    def _camera(self) -> tuple[float, float] | None:
+        return camera_of(self.context.memory)
+
+    def _furniture(self, cand: Candidate) -> list[tuple[np.ndarray, np.ndarray]]:
+        return furniture_boxes(self.context.memory, cand.object_id)
+
+    def _wall_heights(self, cand: Candidate) -> tuple[float, float] | None:
+        return wall_heights(self.context.memory, float(np.asarray(cand.box_max)[2]))
+
+    def _send(self, cand: Candidate, distance: float, strict_walls: bool = False, box_weight: float = 0.0) -> bool:
+        """Go to a cell within ``distance`` of the candidate's footprint (``cell_near``), facing it."""
+        ctx = self.context
+        pose = ctx.pose
+        if pose is None or ctx.grid is None:
+            return False
+        rules = {"centre_weight": self._centre_weight(), "prefer_xy": self._preferred_xy(cand, distance),
+                 "prefer_weight": self._prefer_weight(), "sight": self._sight(cand),
+                 "furniture": self._furniture(cand), "strict_walls": strict_walls, "box_weight": box_weight,
+                 "wall_heights": self._wall_heights(cand)}
+        cell = cell_near(ctx.grid, cand.box_min, cand.box_max, np.array([pose.x, pose.y]), distance, self._excluded,
+                         **rules)
+        if cell is None:
+            return False
+        self._go_to_cell(cand, cell, 0.2)
+        return True
+
+    def _go_to_cell(self, cand: Candidate, cell: np.ndarray, tolerance: float, through_unknown: bool = False) -> None:
+        """Send the goal ``cell`` (world xy) facing the candidate, and restart the stall clock."""
+        self._cell = cell
+        _stall_clock(self).reset()
+        self._seq = self.context.send_goal(Goal(float(cell[0]), float(cell[1]), _facing(cell, cand.center),
+                                                tolerance, "approach", cand.object_id,
+                                                through_unknown=through_unknown))
+
+    def _stall_near(self) -> float:
+        """Within this of the goal cell the robot is there (VerifyTarget glances about its view cell)."""
+        return 0.0
+
+    def _stalled(self) -> bool:
+        """True when the robot has made no progress toward the goal cell for ``stall_s``."""
+        return _stalled_toward(self, getattr(self, "_cell", None), self.param("stall_s"), self._stall_near())
+
+    def cleanup(self, new_status: Status) -> None:
+        if getattr(self, "_seq", None) is not None and self.ctx is not None and new_status != Status.SUCCESS:
+            self.ctx.send_goal(None)
+        self._seq = None
