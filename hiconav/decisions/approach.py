@@ -17,7 +17,7 @@ import numpy as np
 from hiconav.decisions.config import ApproachSettings
 from hiconav.decisions.geometry import facing, wall_clear
 from hiconav.mapping.occupancy import lethal_mask
-from hiconav.types import wrap_angle
+from hiconav.types import Goal, wrap_angle
 
 
 class Gap(NamedTuple):
@@ -126,16 +126,27 @@ def straight_way_in(grid: Any, robot_xy: np.ndarray, box_min: np.ndarray, box_ma
     return bool(wall_clear(grid, ring_xy[None, :], centre, [(lo, hi), *furniture], heights=heights)[0])
 
 
-def creep_goal(measured: Gap, settings: ApproachSettings) -> np.ndarray | None:
-    """Where a creep goes (world xy): the object's nearest point, reached within the distance (a
-    step may end nearer), or None when the robot is already within the distance.
+def creep_goal(measured: Gap, object_id: int, settings: ApproachSettings) -> Goal | None:
+    """The creep's goal: a ``straight`` goal through unknown floor (the robot steps toward it until
+    a step is blocked, without a plan on the map's margins) to the object's nearest point,
+    reached within the distance (a step may end nearer); None when the robot is already within it.
 
     The camera sees no floor near the robot, so the floor by an object is often unknown and no
     approach cell lies there; a robot settled on a wider ring, or stopped by the navigator's
     tolerance short of its cell's ring, steps straight toward the object through that floor until
     a step is blocked, as a real robot inches closer. The goal is the object's point itself, not
     a point short of it: a point short of the box may lie next to the robot and be reached at once."""
-    return None if measured.distance <= settings.distance else measured.near
+    if measured.distance <= settings.distance:
+        return None
+    near = measured.near
+    return Goal(float(near[0]), float(near[1]), None, settings.distance, "approach", object_id,
+                through_unknown=True, straight=True)
+
+
+def face_goal(x: float, y: float, centre: np.ndarray, object_id: int, settings: ApproachSettings) -> Goal:
+    """A turn in place at (``x``, ``y``) world toward the object's ``centre``: where no approach cell
+    is found and the robot is already close, or where a creep ended."""
+    return Goal(x, y, facing(np.array([x, y]), centre), settings.face_tolerance, "look", object_id)
 
 
 def settled_beyond(ring: float, settings: ApproachSettings) -> bool:
@@ -166,5 +177,5 @@ def done(robot_xy: np.ndarray, yaw: float, gap_m: float, ring: float, cell: np.n
     return close and arrived and math.degrees(err) <= settings.facing_tolerance_deg
 
 
-__all__ = ["Gap", "RingTry", "creep_goal", "creeps_on", "done", "gap", "ring_order", "rings", "settled_beyond",
+__all__ = ["Gap", "RingTry", "creep_goal", "creeps_on", "done", "face_goal", "gap", "ring_order", "rings", "settled_beyond",
            "straight_way_in"]

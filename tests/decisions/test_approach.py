@@ -104,10 +104,20 @@ def test_no_straight_way_in_from_farther_than_straight_within_beyond_the_distanc
     assert not straight(room(), (3.5, 5.0), ApproachSettings(straight_within=0.0))
 
 
-def test_a_creep_goes_to_the_objects_nearest_point_and_not_at_all_from_within_the_distance():
+def test_a_creep_goes_straight_through_unknown_floor_to_the_objects_nearest_point_within_the_distance():
     s = ApproachSettings(distance=0.85)
-    assert np.allclose(plan.creep_goal(plan.Gap(1.0, np.array([4.5, 5.0])), s), [4.5, 5.0])
-    assert plan.creep_goal(plan.Gap(0.8, np.array([4.5, 5.0])), s) is None
+    goal = plan.creep_goal(plan.Gap(1.0, np.array([4.5, 5.0])), 3, s)
+    assert (goal.x, goal.y, goal.tolerance, goal.ref_id) == (4.5, 5.0, 0.85, 3)
+    assert goal.straight and goal.through_unknown and goal.kind == "approach"
+
+
+def test_no_creep_from_within_the_distance():
+    assert plan.creep_goal(plan.Gap(0.8, np.array([4.5, 5.0])), 3, ApproachSettings(distance=0.85)) is None
+
+
+def test_a_turn_in_place_faces_the_objects_centre():
+    goal = plan.face_goal(3.0, 5.0, CENTRE, 3, ApproachSettings())
+    assert (goal.x, goal.y, goal.kind) == (3.0, 5.0, "look") and goal.yaw == pytest.approx(0.0)
 
 
 def test_a_robot_done_on_a_settle_ring_creeps_on_and_one_at_a_cell_short_of_a_near_ring_too():

@@ -11,25 +11,17 @@ from __future__ import annotations
 import numpy as np
 
 from hiconav.decisions import approach as plan
-from hiconav.decisions.geometry import facing as _facing
 from hiconav.trees.behaviours.base import Status
 from hiconav.trees.behaviours.goto import _GoToObject
 from hiconav.trees.context import Candidate
 from hiconav.trees.registry import register_behaviour
-from hiconav.types import Goal
 
 
 @register_behaviour()
 class Approach(_GoToObject):
-    """Reach a free cell within ``distance`` of the target's footprint, facing it.
-
-    When no approach cell is reachable or time runs out, the candidate is deferred for
-    ``defer_s`` (an unreachable one until the map around it has grown, as in VerifyTarget)
-    before FAILURE, so that a Retry above explores on (the map may yet open a way to
-    it, or show a better candidate) instead of picking the same unreachable object again.
-    Its cells are in front of the object's middle (``centre_weight``) and are goals to reach,
-    not spots to glance from (``_stall_near`` 0: rocking near a cell never reached is a stall).
-    """
+    """Reach a free cell within ``distance`` of the target's footprint (in front of its middle:
+    ``centre_weight``), facing it. With no cell reachable or time run out, the target is deferred
+    (``defer_s``) before FAILURE, so that a Retry above explores on instead of picking it again."""
 
     SETTINGS = "approach"
 
@@ -37,15 +29,10 @@ class Approach(_GoToObject):
         return self.param("centre_weight")
 
     def initialise(self) -> None:
-        self._start = self.context.now()
-        self._seq = None
-        self._cell = None
-        self._excluded: list[np.ndarray] = []
-        self._attempts = 0
-        self._turned = False
+        self._start, self._seq, self._cell, self._attempts = self.context.now(), None, None, 0
+        self._excluded: list[np.ndarray] = []  # approach cells that failed (world xy)
         self._ring = 0.0  # the approach ring the current goal came from (m)
-        self._crept = False
-        self._straight = False  # the creep under way is the first move (``_straight_in``)
+        self._turned = self._crept = self._straight = False  # _straight: the creep is the straight way in
 
     def update(self) -> Status:
         ctx, s = self.context, self.settings
@@ -58,16 +45,14 @@ class Approach(_GoToObject):
                 np.array([pose.x, pose.y]), pose.yaw, self._gap(cand)[0], self._ring, self._cell, self._turned,
                 cand.center, s):
             if plan.settled_beyond(self._ring, s) and not self._crept and self._creep(cand):
-                self.feedback_message = f"creeping toward {cand.label} #{cand.object_id}"
-                return Status.RUNNING
+                return self._running(f"creeping toward {cand.label} #{cand.object_id}")
             self.feedback_message = f"at {cand.label} #{cand.object_id}"
             return Status.SUCCESS
         if ctx.now() - self._start > s.timeout_s:
             return self._give_up(cand, "timed out")
         state = "pending" if self._seq is None else ctx.nav_state(self._seq)
         if self._seq is None and self._attempts == 0 and not self._crept and self._straight_in(cand):
-            self.feedback_message = f"stepping in toward {cand.label} #{cand.object_id}"
-            return Status.RUNNING
+            return self._running(f"stepping in toward {cand.label} #{cand.object_id}")
         if self._crept and not self._turned and (state in ("failed", "reached")
                                                  or ctx.now() - self._crept_at > s.creep_s):
             if not (self._straight and self._gap(cand)[0] > s.distance):
@@ -78,25 +63,25 @@ class Approach(_GoToObject):
             self._seq, state = None, "pending"
         if state == "reached" and self._cell is not None and not self._crept and plan.creeps_on(self._ring, s) \
                 and self._creep(cand):
-            self.feedback_message = f"creeping toward {cand.label} #{cand.object_id}"
-            return Status.RUNNING
+            return self._running(f"creeping toward {cand.label} #{cand.object_id}")
         if (self._seq is None or state in ("failed", "reached") or self._stalled()) and not self._next_goal(cand):
             return self._give_up(cand, "no reachable approach cell")
-        self.feedback_message = f"approaching {cand.label} #{cand.object_id}"
+        return self._running(f"approaching {cand.label} #{cand.object_id}")
+
+    def _running(self, feedback: str) -> Status:
+        self.feedback_message = feedback
         return Status.RUNNING
 
     def _next_goal(self, cand: Candidate) -> bool:
-        """Drop the cell that failed and send the first cell of the ring order, or, with none and
-        already close, turn toward the target; False when nothing was sent on a known map."""
+        """The next ring cell (``plan.ring_order``), or a turn when close; False: none on a known map."""
         ctx, s = self.context, self.settings
         if self._seq is not None and self._cell is not None:
             self._excluded.append(self._cell)
         self._attempts += 1
-        if self._attempts <= s.max_attempts:
-            for t in plan.ring_order(s):
-                if self._send(cand, t.ring, strict_walls=t.strict, box_weight=t.box_weight):
-                    self._ring = t.ring
-                    return True
+        for t in plan.ring_order(s) if self._attempts <= s.max_attempts else []:
+            if self._send(cand, t.ring, strict_walls=t.strict, box_weight=t.box_weight):
+                self._ring = t.ring
+                return True
         if ctx.pose is not None and self._gap(cand)[0] <= s.distance and not self._turned:
             self._face(cand)
             return True
@@ -111,12 +96,11 @@ class Approach(_GoToObject):
     def _straight_in(self, cand: Candidate) -> bool:
         """Creep straight in when the planner finds the way clear (``plan.straight_way_in``); True when sent."""
         ctx, s = self.context, self.settings
-        pose, grid = ctx.pose, ctx.grid
-        if s.straight_within <= 0.0 or pose is None or grid is None:
+        if s.straight_within <= 0.0 or ctx.pose is None or ctx.grid is None:
             return False
         measured = self._gap(cand)
-        if not plan.straight_way_in(grid, np.array([pose.x, pose.y]), cand.box_min, cand.box_max, measured, s,
-                                    self._furniture(cand), self._wall_heights(cand)):
+        if not plan.straight_way_in(ctx.grid, np.array([ctx.pose.x, ctx.pose.y]), cand.box_min, cand.box_max,
+                                    measured, s, self._furniture(cand), self._wall_heights(cand)):
             return False
         self._creep(cand, measured)  # beyond the distance, so it always sends
         self._straight = True
@@ -126,23 +110,17 @@ class Approach(_GoToObject):
     def _face(self, cand: Candidate) -> None:
         """Turn in place toward the target (done then needs no approach cell)."""
         pose = self.context.pose
-        self._turned = True
-        self._cell = None
-        self._seq = self.context.send_goal(Goal(pose.x, pose.y, _facing(np.array([pose.x, pose.y]), cand.center),
-                                                self.settings.face_tolerance, "look", cand.object_id))
+        self._turned, self._cell = True, None
+        self._seq = self.context.send_goal(plan.face_goal(pose.x, pose.y, cand.center, cand.object_id, self.settings))
 
     def _creep(self, cand: Candidate, measured: plan.Gap | None = None) -> bool:
-        """Creep toward ``plan.creep_goal`` through floor the map does not know, a ``straight`` goal
-        (step until a step is blocked); False when already within the distance."""
-        s = self.settings
-        near = plan.creep_goal(self._gap(cand) if measured is None else measured, s)
-        if near is None:
+        """A straight goal to ``plan.creep_goal`` through unknown floor; False when already close."""
+        measured = self._gap(cand) if measured is None else measured
+        goal = plan.creep_goal(measured, cand.object_id, self.settings)
+        if goal is None:
             return False
-        self._crept = True
-        self._crept_at = self.context.now()
-        self._cell = near
-        self._seq = self.context.send_goal(Goal(float(near[0]), float(near[1]), None, s.distance, "approach",
-                                                cand.object_id, through_unknown=True, straight=True))
+        self._crept, self._crept_at, self._cell = True, self.context.now(), measured.near
+        self._seq = self.context.send_goal(goal)
         return True
 
     def _give_up(self, cand: Candidate, why: str) -> Status:
