@@ -39,9 +39,10 @@ class RingTry(NamedTuple):
 
 def gap(robot_xy: np.ndarray, box_min: np.ndarray, box_max: np.ndarray, points: Any,
         settings: ApproachSettings) -> Gap:
-    """The robot's distance to the object by ``settings.measure``: to the nearest point of its
-    box's footprint, or (``points``, with at least ``min_points`` of them, (N, 3) world) to its
-    points' ``points_quantile`` planar distance.
+    """The robot's distance from ``robot_xy`` (2,) world to the object by ``settings.measure``: to
+    the nearest point of its box's footprint (``box_min``/``box_max`` (3,) world), or, with
+    ``points`` (N, 3) world and at least ``min_points`` of them, to its points'
+    ``points_quantile`` planar distance.
 
     An axis-aligned box reaches past a round or slanted object at its corners, so from the box's
     diagonal the box is nearer than anything of the object; the points are what the camera saw
@@ -83,15 +84,17 @@ def ring_order(settings: ApproachSettings) -> list[RingTry]:
     order += [(False, r) for r in all_rings if r <= distance]
     order += [(strict, r) for strict in (True, False) for r in all_rings
               if r > distance and (strict, r) not in order]
-    return [RingTry(strict, ring, settings.settle_box_weight if ring > distance else 0.0) for strict, ring in order]
+    weight = settings.settle_box_weight
+    return [RingTry(strict, ring, weight if ring > distance else 0.0) for strict, ring in order]
 
 
 def straight_way_in(grid: Any, robot_xy: np.ndarray, box_min: np.ndarray, box_max: np.ndarray, measured: Gap,
                     settings: ApproachSettings, furniture: list[tuple[np.ndarray, np.ndarray]],
                     heights: tuple[float, float] | None) -> bool:
-    """True when the robot, ``measured`` from the object and at most ``straight_within`` beyond
-    the distance, may step straight toward the object's nearest point: the way there is clear on
-    the map (no cell the robot centre may not enter, nor an occupied one, up to ``straight_step``
+    """True when the robot at ``robot_xy`` (2,) world, ``measured`` from the object (box (3,)
+    world) and at most ``straight_within`` beyond the distance, may step straight toward the
+    object's nearest point: the way there is clear on the map (no cell the robot centre may not
+    enter, nor an occupied one, up to ``straight_step``
     past the ring; the robot's own cell may lie in the margin of what it stands by), and the ring
     point on that line sees the footprint's centre past every wall (``wall_clear``, ``furniture``
     (lo, hi) boxes see-through, ``heights`` as there).
@@ -163,9 +166,10 @@ def creeps_on(ring: float, settings: ApproachSettings) -> bool:
 
 def done(robot_xy: np.ndarray, yaw: float, gap_m: float, ring: float, cell: np.ndarray | None, turned: bool,
          centre: np.ndarray, settings: ApproachSettings) -> bool:
-    """The approach is done: within the distance (or the ``ring`` settled for) of the object,
-    facing its ``centre`` within ``facing_tolerance_deg``, and at the approach ``cell`` (world xy,
-    ``arrive_radius``), or, where no cell was found, ``turned`` toward it in place.
+    """The approach is done: the robot at ``robot_xy`` (2,) world heading ``yaw`` (rad) is within
+    the distance (or the ``ring`` settled for) of the object (``gap_m``), facing its ``centre``
+    within ``facing_tolerance_deg``, and at the approach ``cell`` ((2,) world, ``arrive_radius``),
+    or, where no cell was found, ``turned`` toward it in place.
 
     Passing within the distance on the way to a cell is not arriving: the cell lies in front of
     the object, the first point within the distance may be off its end. Nor is standing anywhere
@@ -177,5 +181,5 @@ def done(robot_xy: np.ndarray, yaw: float, gap_m: float, ring: float, cell: np.n
     return close and arrived and math.degrees(err) <= settings.facing_tolerance_deg
 
 
-__all__ = ["Gap", "RingTry", "creep_goal", "creeps_on", "done", "face_goal", "gap", "ring_order", "rings", "settled_beyond",
-           "straight_way_in"]
+__all__ = ["Gap", "RingTry", "creep_goal", "creeps_on", "done", "face_goal", "gap", "ring_order", "rings",
+           "settled_beyond", "straight_way_in"]

@@ -102,16 +102,15 @@ class Approach(_GoToObject):
         if not plan.straight_way_in(ctx.grid, np.array([ctx.pose.x, ctx.pose.y]), cand.box_min, cand.box_max,
                                     measured, s, self._furniture(cand), self._wall_heights(cand)):
             return False
-        self._creep(cand, measured)  # beyond the distance, so it always sends
-        self._straight = True
+        self._straight = self._creep(cand, measured)  # beyond the distance, so it always sends (True)
         ctx.log(f"#{cand.object_id} {measured[0]:.2f} m off, the way in clear: stepping straight in")
         return True
 
     def _face(self, cand: Candidate) -> None:
         """Turn in place toward the target (done then needs no approach cell)."""
-        pose = self.context.pose
-        self._turned, self._cell = True, None
-        self._seq = self.context.send_goal(plan.face_goal(pose.x, pose.y, cand.center, cand.object_id, self.settings))
+        pose, self._turned, self._cell = self.context.pose, True, None
+        self._seq = self.context.send_goal(plan.face_goal(pose.x, pose.y, cand.center, cand.object_id,
+                                                          self.settings))
 
     def _creep(self, cand: Candidate, measured: plan.Gap | None = None) -> bool:
         """A straight goal to ``plan.creep_goal`` through unknown floor; False when already close."""
