@@ -154,6 +154,17 @@ class ApproachSettings(_Section):
                                      "way and the view from the ring are clear (0: always a ring cell)", 0.0, 5.0)
     stall_s: float = _f(6.0, "an approach cell the robot came no nearer to (by 0.25 m) for this long counts as "
                              "failed", 0.1, 600.0)
+    min_ring: float = _f(0.2, "no ring for an approach cell lies nearer the footprint than this (m)", 0.0, 5.0)
+    second_margin: float = _f(0.1, "a second ring lies at most this far inside the distance (m)", 0.0, 5.0)
+    strict_within: float = _f(1.0, "on the rings out to this, cells that see the footprint past every wall are "
+                                   "tried first (m; the success distance)", 0.0, 5.0)
+    creep_within: float = _f(1.0, "reached a cell of a ring out to this short of the ring: creep on rather than "
+                                  "drive to another cell (m)", 0.0, 5.0)
+    straight_step: float = _f(0.25, "the straight way in is checked this far past the ring: a step may end up to a "
+                                    "step inside it (the robot's forward step, m)", 0.0, 2.0)
+    min_points: int = _f(10, "with measure 'points', a node with fewer points is measured by its box", 1, 100000)
+    face_tolerance: float = _f(0.5, "the turn in place toward the target counts as reached this near where the "
+                                    "robot stands (m)", 0.0, 5.0)
 
 
 class ReturnSettings(_Section):
