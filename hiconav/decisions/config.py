@@ -66,6 +66,7 @@ class ExploreSettings(_Section):
     push_s: float = _f(6.0, "clock seconds a push may take before it counts as blocked", 0.1, 600.0)
     stall_s: float = _f(8.0, "a frontier goal the robot came no nearer to (by progress_m) for this long is "
                              "skipped: a passage the map shows open that the robot does not fit", 0.1, 600.0)
+    stall_near: float = _f(0.35, "within this of a frontier goal the robot is arriving, not stalled (m)", 0.0, 5.0)
     progress_m: float = _f(0.25, "coming this much nearer a goal is progress (stall and idle clocks, m)",
                            0.01, 5.0)
     squeeze: bool = _f(True, "with every frontier failed, try each once more through unknown floor on the "
