@@ -182,6 +182,25 @@ def may_try_unknown(settings: VerifySettings, moves: int, n_obs: int) -> bool:
     return moves < settings.unknown_moves and int(n_obs) >= settings.unknown_min_observations
 
 
+def fallback_cell(kind: str, settings: VerifySettings, grid: Any, box_min: np.ndarray, box_max: np.ndarray,
+                  robot_xy: np.ndarray, *, gap: float, ring: float, excluded: list[np.ndarray], moves: int, n_obs: int,
+                  furniture: list[tuple[np.ndarray, np.ndarray]] | None,
+                  view: tuple[np.ndarray, float, np.ndarray, np.ndarray] | None,
+                  heights: tuple[float, float] | None) -> np.ndarray | None:
+    """The cell (world xy) of a ``next_view_move`` fallback ``kind``: "closer" (``closer_cell``,
+    fewer than ``closer_moves`` made: ``moves``) or "unknown" (``through_unknown_cell``, while
+    ``may_try_unknown``); None when that move is spent or finds no cell. ``gap``: the robot's
+    distance (m) to the box; ``ring``: the view ring; ``view``: the ``sight`` argument."""
+    if kind == "closer":
+        if moves >= settings.closer_moves:
+            return None
+        return closer_cell(grid, box_min, box_max, robot_xy, gap, close_distance(settings, ring), settings,
+                           furniture, heights)
+    if kind == "unknown" and may_try_unknown(settings, moves, n_obs):
+        return through_unknown_cell(grid, box_min, box_max, robot_xy, ring, excluded, furniture, view, heights)
+    return None
+
+
 @dataclass(frozen=True)
 class ViewMove:
     """What a verification in progress does next.
@@ -249,5 +268,5 @@ def next_view_move(settings: VerifySettings, *, close: bool, sent: bool, state: 
 
 
 __all__ = ["DONE", "MIN_HALF_FOV", "MIN_VIEW_RING", "ViewMove", "blockers", "box_distance", "close_distance",
-           "closer_cell", "may_switch", "may_try_unknown", "nearer_candidate", "next_view_move", "seen_from", "sight",
+           "closer_cell", "fallback_cell", "may_switch", "may_try_unknown", "nearer_candidate", "next_view_move", "seen_from", "sight",
            "stall_matters", "through_unknown_cell", "view_ring"]

@@ -29,18 +29,14 @@ CLOSER_TOLERANCE, UNKNOWN_TOLERANCE, GLANCE_TOLERANCE = 0.3, 0.2, 0.5
 @register_behaviour()
 class VerifyTarget(_GoToObject):
     """Go within ``verify_distance`` of the candidate, facing it, and confirm it with fresh views
-    (``confirmation.evidence_verdict``), glancing ``glance_deg`` left and right of it so that
-    each glance makes an anchor; view cells, closer cells and the ways through unknown floor come
-    from ``viewing`` (``next_view_move``). A verdict rejects the candidate for good or defers it
-    (``_reject``: ``MissionContext.reject``), so exploration resumes; a confirmed one is written
-    as the target (the supporting node its fresh views observed most)."""
+    (``confirmation``), glancing ``glance_deg`` left and right of it so that each glance makes an
+    anchor; view, closer and through-unknown cells and the next move come from ``viewing``. A
+    verdict rejects or defers the candidate (``MissionContext.reject``), so exploration resumes;
+    a confirmed one is written as the target (the supporting node its fresh views saw most)."""
 
     SETTINGS = "verify"
     WRITES = ("target",)
     READS = ()
-
-    def _stall_near(self) -> float:
-        return self.param("stall_near")
 
     def initialise(self) -> None:
         self._switches = 0  # switches to a nearer candidate since the tree started this behaviour
@@ -58,12 +54,21 @@ class VerifyTarget(_GoToObject):
         if self._cand is not None and self.context.verify:
             self._send(self._cand, self._ring(self._cand))
 
+    # -- the hooks of _GoToObject and the inputs of the core ---------------------------------------
+    def _stall_near(self) -> float:
+        return self.param("stall_near")
+
+    def _prefer_weight(self) -> float:
+        return self.param("view_ray_weight")
+
     def _ring(self, cand: Candidate) -> float:
         return view.view_ring(self.settings, float(np.asarray(cand.center)[2]), self._camera())
 
+    def _targets(self, label: str) -> set[str]:
+        return conf.target_labels(self.context.task.targets if self.context.task is not None else None, label)
+
     def _support(self, cand: Candidate) -> set[int]:
-        labels = conf.target_labels(self.context.task.targets if self.context.task is not None else None, cand.label)
-        return conf.support_ids(self.context.memory.objects, labels, cand.box_min, cand.box_max,
+        return conf.support_ids(self.context.memory.objects, self._targets(cand.label), cand.box_min, cand.box_max,
                                 self.param("support_margin"))
 
     def _blockers(self, cand: Candidate, support: set[int] | None = None) -> tuple[np.ndarray, np.ndarray] | None:
@@ -74,9 +79,6 @@ class VerifyTarget(_GoToObject):
         camera, hiding = self._camera(), self._blockers(cand)
         return view.sight(cand.center, camera, hiding)
 
-    def _prefer_weight(self) -> float:
-        return self.param("view_ray_weight")
-
     def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
         memory, obj = self.context.memory, self.context.object(cand.object_id)
         ids = set(int(i) for i in getattr(obj, "anchor_ids", ()) or ())
@@ -84,19 +86,17 @@ class VerifyTarget(_GoToObject):
             return None
         return view.seen_from(cand.center, getattr(memory, "anchors", ()) or (), ids, distance)
 
-    def _reject(self, why: str, permanent: bool, requalify: bool = False, remap: bool = False) -> Status:
-        cand = self._cand
-        if cand is not None:
-            ctx, oid = self.context, cand.object_id
-            remap = remap and not permanent and ctx.can_remap(oid)  # map deferrals: up to max_remaps
+    # -- polling ---------------------------------------------------------------------------------
+    def _reject(self, verdict: conf.Verdict) -> Status:
+        """Post a rejection or deferral (``verdict``) of the candidate; FAILURE."""
+        if self._cand is not None:
+            ctx, oid = self.context, self._cand.object_id
+            remap = verdict.remap and not verdict.permanent and ctx.can_remap(oid)  # up to max_remaps
             count = sum(1 for i, _ in ctx.rejections if i == oid) - ctx.remaps.get(oid, 0) + 1
-            ctx.reject(oid, why, permanent=conf.for_good(self.settings, permanent, remap, count),
-                       defer_s=self.param("defer_s"), requalify=requalify, remap=remap)
-        self.feedback_message = f"{'rejected' if permanent else 'deferred'}: {why}"
+            ctx.reject(oid, verdict.reason, permanent=conf.for_good(self.settings, verdict.permanent, remap, count),
+                       defer_s=self.param("defer_s"), requalify=verdict.requalify, remap=remap)
+        self.feedback_message = f"{'rejected' if verdict.permanent else 'deferred'}: {verdict.reason}"
         return Status.FAILURE
-
-    def _verdict(self, verdict: conf.Verdict) -> Status:
-        return self._reject(verdict.reason, verdict.permanent, verdict.requalify, verdict.remap)
 
     def _switch(self, obj: object, cand: Candidate) -> Candidate | None:
         """A candidate nearer the robot than ``cand`` (memory node ``obj``) to verify first, or None."""
@@ -109,21 +109,19 @@ class VerifyTarget(_GoToObject):
                                      self.settings)
 
     def _judge(self, current: Candidate, obj: object) -> Status | None:
-        """Judge the new frames of ``current`` (close to it) and return its verdict's status, or None."""
+        """Judge the new frames of ``current`` (close to it); its verdict's status, or None."""
         ctx, memory = self.context, self.context.memory
         frames, self._last_anchor = conf.frames_since(tuple(getattr(memory, "anchors", ()) or ()), self._last_anchor)
         support = self._support(current)
         if frames:
-            targets = conf.target_labels(ctx.task.targets if ctx.task is not None else None, current.label)
             self._tally = conf.judge_frames(self._tally, frames, objects=memory.objects, grid=ctx.grid,
-                                            center=current.center, box_min=current.box_min,
-                                            box_max=current.box_max, support=support,
-                                            hiding=self._blockers(current, support), targets=targets,
-                                            near=self.param("near_view_distance"))
+                                            center=current.center, box_min=current.box_min, box_max=current.box_max,
+                                            support=support, hiding=self._blockers(current, support),
+                                            targets=self._targets(current.label), near=self.param("near_view_distance"))
         verdict = conf.evidence_verdict(self.settings, self._tally, label=self._cand.label, n_obs=int(obj.n_obs),
                                         objects=memory.objects, support=support)
         if verdict is None or verdict.outcome != "confirmed":
-            return None if verdict is None else self._verdict(verdict)
+            return None if verdict is None else self._reject(verdict)
         found, node = conf.confirmed_node(self._tally, current.object_id), None
         if found is not None and (node := ctx.object(found[0])) is not None:
             ctx.log(f"#{current.object_id} confirmed by views of #{found[0]} ({found[1]} of them): going to #{found[0]}")
@@ -131,43 +129,40 @@ class VerifyTarget(_GoToObject):
         self.feedback_message = f"confirmed {obj.label} #{obj.id}: {verdict.reason}"
         return Status.SUCCESS
 
-    def _try(self, move: str, current: Candidate) -> str | None:
-        """Send the goal of ``move`` (a ``ViewMove`` try); its feedback, or None when it cannot go."""
+    def _try(self, kind: str, current: Candidate) -> str | None:
+        """Send the goal of a ``ViewMove`` try: its feedback ("" for none), or None when it cannot go."""
         ctx, cand, pose = self.context, self._cand, self.context.pose
-        if move == "view":
+        if kind == "view":
             return "" if self._send(current, self._ring(current)) else None
-        if move == "glance":
-            face = _facing(np.array([pose.x, pose.y]), current.center)
-            offset = math.radians((self.param("glance_deg"), -self.param("glance_deg"))[self._glance % 2])
+        if kind == "glance":
+            face, glance = _facing(np.array([pose.x, pose.y]), current.center), self.param("glance_deg")
+            offset = math.radians((glance, -glance)[self._glance % 2])
             self._glance += 1
             self._seq = ctx.send_goal(Goal(pose.x, pose.y, wrap_angle(face + offset), GLANCE_TOLERANCE, "look",
                                            cand.object_id))
             return ""
         if ctx.grid is None or pose is None:
             return None
-        robot, gap = np.array([pose.x, pose.y]), ctx.distance_to_box(current.box_min, current.box_max)
-        if move == "closer" and self._closer_moves < self.param("closer_moves"):
-            cell = view.closer_cell(ctx.grid, current.box_min, current.box_max, robot, gap,
-                                    view.close_distance(self.settings, self._ring(current)), self.settings,
-                                    self._furniture(current), self._wall_heights(current))
-            if cell is not None:
-                self._closer_moves += 1
-                self._closing = True
-                self._go_to_cell(current, cell, CLOSER_TOLERANCE)
-                ctx.log(f"no view cell of #{cand.object_id} on the map yet: closing in to "
-                        f"({cell[0]:.2f}, {cell[1]:.2f}), {gap:.1f} m from it now")
-                return f"closing in on {cand.label} #{cand.object_id}"
-        if move == "unknown" and view.may_try_unknown(self.settings, self._unknown_moves, current.n_obs):
-            cell = view.through_unknown_cell(ctx.grid, current.box_min, current.box_max, robot, self._ring(current),
-                                             self._excluded, self._furniture(current), self._sight(current),
-                                             self._wall_heights(current))
-            if cell is not None:
-                self._unknown_moves += 1
-                self._go_to_cell(current, cell, UNKNOWN_TOLERANCE, through_unknown=True)
-                ctx.log(f"no view cell of #{cand.object_id} reachable on the known map: heading for "
-                        f"({cell[0]:.2f}, {cell[1]:.2f}) through unknown floor")
-                return f"heading for {cand.label} #{cand.object_id} through unknown floor"
-        return "remap" if move == "remap" else None
+        if kind == "remap":
+            return kind
+        closer, robot = kind == "closer", np.array([pose.x, pose.y])
+        gap = ctx.distance_to_box(current.box_min, current.box_max)
+        cell = view.fallback_cell(kind, self.settings, ctx.grid, current.box_min, current.box_max, robot, gap=gap,
+                                  ring=self._ring(current), excluded=self._excluded, n_obs=current.n_obs,
+                                  moves=self._closer_moves if closer else self._unknown_moves,
+                                  furniture=self._furniture(current), heights=self._wall_heights(current),
+                                  view=None if closer else self._sight(current))
+        if cell is None:
+            return None
+        self._closer_moves, self._unknown_moves = self._closer_moves + closer, self._unknown_moves + (not closer)
+        self._closing = self._closing or closer
+        self._go_to_cell(current, cell, CLOSER_TOLERANCE if closer else UNKNOWN_TOLERANCE, through_unknown=not closer)
+        where = f"({cell[0]:.2f}, {cell[1]:.2f})"
+        ctx.log(f"no view cell of #{cand.object_id} on the map yet: closing in to {where}, {gap:.1f} m from it now"
+                if closer else f"no view cell of #{cand.object_id} reachable on the known map: heading for {where} "
+                f"through unknown floor")
+        return f"closing in on {cand.label} #{cand.object_id}" if closer else \
+            f"heading for {cand.label} #{cand.object_id} through unknown floor"
 
     def update(self) -> Status:
         ctx, cand = self.context, self._cand
@@ -179,7 +174,7 @@ class VerifyTarget(_GoToObject):
             return Status.SUCCESS
         obj = ctx.object(cand.object_id)
         if obj is None:
-            return self._reject("object node disappeared from memory", True)
+            return self._reject(conf.Verdict("rejected", "object node disappeared from memory"))
         nearer = self._switch(obj, cand)
         if nearer is not None:
             ctx.log(f"#{nearer.object_id} is {self.param('switch_margin'):.1f} m or more nearer than #{cand.object_id}: "
@@ -189,12 +184,12 @@ class VerifyTarget(_GoToObject):
             self._take(nearer)  # the other candidate stays a candidate: it is neither rejected nor deferred
             self.feedback_message = f"verifying {nearer.label} #{nearer.object_id} first"
             return Status.RUNNING
-        flipped = conf.label_verdict(ctx.task.targets if ctx.task is not None else None, obj.label, cand.source)
-        if flipped is not None:
-            return self._verdict(flipped)
         current = Candidate(cand.object_id, str(obj.label), np.asarray(obj.center, dtype=np.float64),
                             np.asarray(obj.box_min), np.asarray(obj.box_max), float(obj.confidence), int(obj.n_obs),
                             cand.source)
+        flipped = conf.label_verdict(ctx.task.targets if ctx.task is not None else None, obj.label, cand.source)
+        if flipped is not None:
+            return self._reject(flipped)
         # judged every tick, for the current box: the box grows as it is seen
         self._close = ctx.distance_to_box(current.box_min, current.box_max) <= \
             view.close_distance(self.settings, self._ring(current))
@@ -202,33 +197,30 @@ class VerifyTarget(_GoToObject):
             return judged
         late = conf.timeout_verdict(self.settings, ctx.now() - self._start)
         if late is not None:
-            return self._verdict(late)
+            return self._reject(late)
         sent = self._seq is not None
         state = "pending" if not sent else ctx.nav_state(self._seq)
-        has_cell = getattr(self, "_cell", None) is not None
-        move = view.next_view_move(self.settings, close=self._close, sent=sent, state=state,
-                                   unseen=self._tally.unseen, excluded=len(self._excluded), has_cell=has_cell,
+        move = view.next_view_move(self.settings, close=self._close, sent=sent, state=state, unseen=self._tally.unseen,
+                                   excluded=len(self._excluded), has_cell=getattr(self, "_cell", None) is not None,
                                    closing=self._closing,
                                    stalled=view.stall_matters(self._close, sent, state) and self._stalled())
         if move.reason is not None:
-            return self._verdict(conf.deferred(move.reason))
+            return self._reject(conf.deferred(move.reason))
         if move.exclude_cell:
             self._excluded.append(self._cell)
-        if move.reset_unseen:
-            self._tally = conf.restart_unseen(self._tally)
-        if move.stop_closing:
-            self._closing = False
+        self._tally = conf.restart_unseen(self._tally) if move.reset_unseen else self._tally
+        self._closing = self._closing and not move.stop_closing
         for kind in move.tries:
             said = self._try(kind, current)
             if said == "remap":
-                return self._verdict(conf.deferred("no reachable view point", remap=True))
+                return self._reject(conf.deferred("no reachable view point", remap=True))
+            if said:
+                self.feedback_message = said
+                return Status.RUNNING
+            if said is not None and move.another_cell and kind == "view":
+                self.feedback_message = f"verifying {cand.label} #{cand.object_id} from another cell"
+                return Status.RUNNING
             if said is not None:
-                if said:
-                    self.feedback_message = said
-                    return Status.RUNNING
-                if move.another_cell and kind == "view":
-                    self.feedback_message = f"verifying {cand.label} #{cand.object_id} from another cell"
-                    return Status.RUNNING
                 break
         self.feedback_message = f"verifying {cand.label} #{cand.object_id}"
         return Status.RUNNING
