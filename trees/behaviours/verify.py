@@ -76,8 +76,7 @@ class VerifyTarget(_GoToObject):
         return view.blockers(self.context.memory.objects, cand.box_min, cand.box_max, skip, self.settings)
 
     def _sight(self, cand: Candidate) -> tuple[np.ndarray, float, np.ndarray, np.ndarray] | None:
-        camera, hiding = self._camera(), self._blockers(cand)
-        return view.sight(cand.center, camera, hiding)
+        return view.sight(cand.center, self._camera(), self._blockers(cand))
 
     def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
         memory, obj = self.context.memory, self.context.object(cand.object_id)
@@ -129,11 +128,14 @@ class VerifyTarget(_GoToObject):
         self.feedback_message = f"confirmed {obj.label} #{obj.id}: {verdict.reason}"
         return Status.SUCCESS
 
-    def _try(self, kind: str, current: Candidate) -> str | None:
-        """Send the goal of a ``ViewMove`` try: its feedback ("" for none), or None when it cannot go."""
+    def _try(self, kind: str, current: Candidate, another: bool) -> str | None:
+        """Send the goal of a ``ViewMove`` try (``another``: another view cell): its feedback ("" for
+        the plain one), or None when it cannot go."""
         ctx, cand, pose = self.context, self._cand, self.context.pose
         if kind == "view":
-            return "" if self._send(current, self._ring(current)) else None
+            if not self._send(current, self._ring(current)):
+                return None
+            return f"verifying {cand.label} #{cand.object_id} from another cell" if another else ""
         if kind == "glance":
             face, glance = _facing(np.array([pose.x, pose.y]), current.center), self.param("glance_deg")
             offset = math.radians((glance, -glance)[self._glance % 2])
@@ -210,17 +212,8 @@ class VerifyTarget(_GoToObject):
             self._excluded.append(self._cell)
         self._tally = conf.restart_unseen(self._tally) if move.reset_unseen else self._tally
         self._closing = self._closing and not move.stop_closing
-        for kind in move.tries:
-            said = self._try(kind, current)
-            if said == "remap":
-                return self._reject(conf.deferred("no reachable view point", remap=True))
-            if said:
-                self.feedback_message = said
-                return Status.RUNNING
-            if said is not None and move.another_cell and kind == "view":
-                self.feedback_message = f"verifying {cand.label} #{cand.object_id} from another cell"
-                return Status.RUNNING
-            if said is not None:
-                break
-        self.feedback_message = f"verifying {cand.label} #{cand.object_id}"
+        said = next((t for t in (self._try(k, current, move.another_cell) for k in move.tries) if t is not None), "")
+        if said == "remap":
+            return self._reject(conf.deferred("no reachable view point", remap=True))
+        self.feedback_message = said or f"verifying {cand.label} #{cand.object_id}"
         return Status.RUNNING
