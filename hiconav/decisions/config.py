@@ -82,6 +82,13 @@ class VerifySettings(_Section):
     fov_spare_deg: float = _f(8.0, "the view ring is far enough for the candidate's centre to be this far inside "
                                    "the vertical field of view", 0.0, 45.0)
     max_view_ring: float = _f(4.0, "the view ring widens for high or low objects up to this (m)", 0.3, 20.0)
+    close_ring_gap: float = _f(0.35, "frames are judged from at least this beyond the view ring (m)", 0.0, 5.0)
+    close_margin: float = _f(0.25, "frames are judged this far beyond verify_distance or the view ring, and a "
+                                   "closer cell must lie beyond that less this (m)", 0.0, 5.0)
+    stand_margin: float = _f(0.05, "objects whose footprint overlaps the candidate's grown by this hold it up or "
+                                   "hang it and never hide it (m)", 0.0, 2.0)
+    blocker_shrink: float = _f(0.05, "other objects' boxes shrink by this a side horizontally before they may "
+                                     "hide the candidate: box edges are loose (m)", 0.0, 1.0)
     min_fresh_views: int = _f(2, "frames in view that observed the candidate needed to confirm it", 0, 100)
     min_detection_rate: float = _f(0.5, "fresh views per frame with the candidate in view needed to confirm it",
                                    0.0, 1.0)
