@@ -130,7 +130,7 @@ class ReasoningNode(Node):
         self._busy(now, delay)
         self.events.append({"t": now, "kind": "verify", "subgraph": getattr(subgraph, "kind", ""),
                             "found": bool(result.found), "reason": result.reason, "latency_s": delay,
-                            "source": result.source})
+                            "source": result.source, "detail": result.detail[:400]})
         if result.found and result.hypothesis is not None:
             self.emit(("mission", "memory", "recorder"), HypothesisMsg(result.hypothesis, now + delay, now, "", result.detail,
                                                            str(getattr(subgraph, "kind", ""))), delay)

@@ -26,7 +26,7 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -85,6 +85,10 @@ class MissionConfig(BaseModel):
     # reasoning.latency_s +- reasoning.latency_jitter_s)
     vlm_latency_s: float | None = Field(None, ge=0, le=MAX_DURATION_S)
     parse_latency_s: float | None = Field(None, ge=0, le=MAX_DURATION_S)
+    # stepped: reasoning.latency_s is robot time ("robot": a call spans as many discrete actions as
+    # a real robot makes in that time, ACTION_SECONDS each) or clock seconds ("clock": one action
+    # per driver tick, so at 10 Hz a 2 s call spans 20 actions, 5 m of driving)
+    latency_time: Literal["robot", "clock"] = "robot"
     max_time_s: float = Field(600.0, gt=0, le=MAX_DURATION_S)  # clock seconds before the run is cut off
     prune_every: int = Field(20, ge=0)  # ILP anchor pruning every n integrations (0: never)
     control_mode: str = Field("discrete", pattern="^(discrete|velocity)$")
@@ -94,19 +98,31 @@ class MissionConfig(BaseModel):
 
 
 class LatencyModel:
-    """A reasoning call's modelled latency on the stepped clock: ``base`` +- ``jitter`` seconds,
-    uniform, from a generator seeded per mission (``float(model)`` draws the next call's)."""
+    """A reasoning call's modelled latency on the stepped clock: ``base`` +- ``jitter`` seconds of
+    robot time, uniform, from a generator seeded per mission (``float(model)`` draws the next
+    call's), times ``scale``: the stepped clock's seconds per second of robot time."""
 
-    def __init__(self, base: float, jitter: float, seed: int) -> None:
+    def __init__(self, base: float, jitter: float, seed: int, scale: float = 1.0) -> None:
         import numpy as np
 
         self.base, self.jitter = float(base), min(float(jitter), float(base))
+        self.scale = float(scale)
         self._rng = np.random.default_rng([int(seed), 0x5EA5])
 
     def __float__(self) -> float:
         if self.jitter <= 0:
-            return self.base
-        return float(self.base + self._rng.uniform(-self.jitter, self.jitter))
+            return self.base * self.scale
+        return float(self.base + self._rng.uniform(-self.jitter, self.jitter)) * self.scale
+
+
+def stepped_time_scale(rates: Any, control_mode: str) -> float:
+    """Stepped-clock seconds per second of robot time: one driver tick (``1 / rates.driver`` clock
+    seconds) carries one discrete action, which takes a robot ``ACTION_SECONDS`` (a 0.25 m step at
+    0.5 m/s, a 30 degree turn), or, in velocity mode, ``1 / rates.control`` seconds of motion."""
+    from hiconav.sim.simulator import ACTION_SECONDS
+
+    robot_s = ACTION_SECONDS if control_mode == "discrete" else 1.0 / float(rates.control)
+    return (1.0 / float(rates.driver)) / robot_s
 
 
 def area_config(cls: type[BaseModel], overrides: dict[str, Any], area: str) -> BaseModel:
@@ -220,7 +236,11 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
         # wall time of local computation depends on the machine's load (a first MiniLM encode
         # takes 0.1-1 s) and would make same-seed runs differ, and a real VLM's would make them
         # depend on the network. Seeded jitter, one draw per call.
-        model = LatencyModel(r_cfg.latency_s, r_cfg.latency_jitter_s, seed)
+        # The model is in robot time: a 2 s call lasts as long as 4 discrete actions of a robot at
+        # 0.5 m/s, whatever the stepped clock's tick (``mission.latency_time: clock`` takes it
+        # in clock seconds instead, 20 actions at the default 10 Hz)
+        scale = stepped_time_scale(cfg.rates, cfg.control_mode) if cfg.latency_time == "robot" else 1.0
+        model = LatencyModel(r_cfg.latency_s, r_cfg.latency_jitter_s, seed, scale)
         vlm_latency = model if vlm_latency is None else vlm_latency
         parse_latency = model if parse_latency is None else parse_latency
     rates = cfg.rates

@@ -50,6 +50,9 @@ class Subgraph:
     priority: float
     signature: tuple
     focus_object_id: int | None = None
+    # memory objects near the focus object that its anchors do not show (a described instance:
+    # "the laptop near the tv stand" holds on the map even when no one image holds both)
+    context: tuple[ObjectView, ...] = ()
 
     @property
     def anchor_ids(self) -> tuple[int, ...]:
@@ -96,6 +99,27 @@ def _signature(kind: str, anchors: tuple[AnchorView, ...], objects: tuple[Object
     return (kind, tuple((a.id, a.object_ids) for a in anchors), tuple((o.id, o.label) for o in objects))
 
 
+def _gap(a: ObjectView, b: ObjectView) -> float:
+    """Planar gap (m) between two nodes' axis-aligned boxes (0 where they overlap)."""
+    lo_a, hi_a = np.asarray(a.box_min, dtype=np.float64)[:2], np.asarray(a.box_max, dtype=np.float64)[:2]
+    lo_b, hi_b = np.asarray(b.box_min, dtype=np.float64)[:2], np.asarray(b.box_max, dtype=np.float64)[:2]
+    d = np.maximum(np.maximum(lo_b - hi_a, lo_a - hi_b), 0.0)
+    return float(np.hypot(d[0], d[1]))
+
+
+def _context(snapshot: MemorySnapshot, focus: ObjectView, shown: tuple[ObjectView, ...],
+             radius: float) -> tuple[ObjectView, ...]:
+    """The snapshot's objects within ``radius`` of ``focus``'s box that ``shown`` lacks, by id."""
+    have = {o.id for o in shown}
+    return tuple(o for o in snapshot.objects if o.id not in have and _gap(focus, o) <= radius)
+
+
+def _described(task: TaskSpec) -> bool:
+    """The task singles out one instance by relations whose subject is one of its targets."""
+    targets = {_norm(t) for t in task.targets}
+    return any(len(r) >= 3 and _norm(str(r[0])) in targets for r in task.relations)
+
+
 def _objects_of(snapshot: MemorySnapshot, anchors: tuple[AnchorView, ...]) -> tuple[ObjectView, ...]:
     ids = sorted({oid for a in anchors for oid in a.object_ids if snapshot.has_object(oid)})
     return tuple(snapshot.object(i) for i in ids)  # eq. (9): V_o^k = union of O(a_i)
@@ -103,8 +127,13 @@ def _objects_of(snapshot: MemorySnapshot, anchors: tuple[AnchorView, ...]) -> tu
 
 def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[str, str], float],
               k: int = 5, *, label_match_threshold: float = 0.8,
-              far_evidence_weight: float = 0.5) -> list[Subgraph]:
+              far_evidence_weight: float = 0.5, context_m: float = 2.5) -> list[Subgraph]:
     """Subgraphs of ``snapshot`` for ``task``, in the order the reasoner should query them.
+
+    For a described instance (relations on the target), each target subgraph also carries the
+    memory objects within ``context_m`` of its focus object's box that its anchors do not show
+    (``Subgraph.context``, part of its signature: a related object mapped from elsewhere makes
+    the subgraph due again). 0: none.
 
     similarity(a, b) -> float in [-1, 1] (e.g. ``Embedder.similarity``). An object matches a
     target/related word when the normalised labels are equal or their similarity is at least
@@ -132,6 +161,7 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
 
     out: list[Subgraph] = []
     used: set[int] = set()
+    described = context_m > 0 and _described(task)
     for kind, words in (("target", tuple(task.targets)), ("related", tuple(task.related))):
         if not words:
             continue
@@ -149,8 +179,9 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
                 continue  # the VLM would see exactly the same images again
             used.update(a.id for a in chosen)
             objs = _objects_of(snapshot, chosen)
-            built.append(Subgraph(kind, chosen, objs, score(chosen, objs),
-                                  _signature(kind, chosen, objs), o.id))
+            near = _context(snapshot, o, objs, context_m) if kind == "target" and described else ()
+            sig = _signature(kind, chosen, objs) + ((tuple((c.id, c.label) for c in near),) if near else ())
+            built.append(Subgraph(kind, chosen, objs, score(chosen, objs), sig, o.id, near))
         if kind == "related":
             built.sort(key=lambda g: -g.priority)
         out.extend(built)

@@ -65,6 +65,9 @@ class OfflineVerifierConfig(BaseModel):
 
     min_confidence: float = Field(0.5, ge=0, le=1)  # detector confidence of the object node
     min_observations: int = Field(2, ge=1)  # n_obs of the object node
+    # a node observed this often passes min_confidence: detectors score small and far objects low
+    # in every frame, and many observations are evidence the score is not (0: never)
+    confident_observations: int = Field(10, ge=0)
     min_similarity: float = Field(0.85, ge=0, le=1)  # label-target similarity when not equal
 
 

@@ -244,13 +244,15 @@ class OfflineVerifier:
         reasons: list[str] = []
         described = bool(target_relations(task.relations, task.targets))
         objects = list(subgraph.objects)
-        rooms = infer_rooms(objects) if described else None
+        context = list(getattr(subgraph, "context", ()) or ())
+        rooms = infer_rooms(objects + context) if described else None
         groundings: dict[int, Any] = {}
         for obj in subgraph.objects:
             score, target = self._match(obj.label, task.targets)
             if score < 1.0 and score < cfg.min_similarity:
                 continue
-            if obj.confidence < cfg.min_confidence:
+            if obj.confidence < cfg.min_confidence and not (cfg.confident_observations
+                                                            and obj.n_obs >= cfg.confident_observations):
                 reasons.append(LOW_CONFIDENCE)
                 continue
             if obj.n_obs < cfg.min_observations:
@@ -261,7 +263,8 @@ class OfflineVerifier:
                 reasons.append(NO_MATCH)
                 continue
             if described:
-                verdict = ground(obj, objects, task.relations, task.targets, rooms)
+                # relations on the map: the subgraph's objects and the nodes mapped near it
+                verdict = ground(obj, objects + context, task.relations, task.targets, rooms)
                 groundings[obj.id] = verdict
                 if verdict.status != "holds":
                     reasons.append(RELATION_FAILED if verdict.status == "fails" else RELATION_UNKNOWN)

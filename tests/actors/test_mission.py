@@ -164,7 +164,11 @@ def test_stepped_offline_reasoning_takes_no_measured_wall_time(house, episodes, 
     assert isinstance(parts.reasoning.latency_s, LatencyModel)
     again = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder)
     assert [float(parts.reasoning.latency_s) for _ in range(5)] == [float(again.reasoning.latency_s) for _ in range(5)]
-    assert 1.5 <= float(parts.reasoning.parse_latency_s) <= 2.5
+    # robot time: 2.0 +- 0.5 s of a robot making one 0.5 s action per 0.1 s driver tick
+    assert 1.5 * 0.2 <= float(parts.reasoning.parse_latency_s) <= 2.5 * 0.2
+    clock = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder,
+                          overrides={"mission.latency_time": "clock"})
+    assert 1.5 <= float(clock.reasoning.parse_latency_s) <= 2.5
     instant = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder,
                             overrides={"reasoning.latency_s": 0.0})
     assert float(instant.reasoning.latency_s) == 0.0

@@ -72,3 +72,21 @@ def test_asynchronous_control_moves_while_reasoning_thinks():
     node, nav = _control(hold=False)
     node.run_tick(1.0)
     assert nav.steps == 1
+
+
+def test_the_latency_model_is_in_robot_time_on_the_stepped_clock():
+    """A discrete action takes a robot ACTION_SECONDS (0.5 s); the stepped clock gives it one
+    driver tick (0.1 s at 10 Hz), so 2 s of reasoning lasts 0.4 clock seconds: four actions, as
+    on a real robot, not twenty."""
+    from types import SimpleNamespace
+
+    from hiconav.mission import stepped_time_scale
+    from hiconav.sim.simulator import ACTION_SECONDS
+
+    rates = SimpleNamespace(driver=10.0, control=10.0)
+    assert stepped_time_scale(rates, "discrete") == 0.1 / ACTION_SECONDS == 0.2
+    assert stepped_time_scale(rates, "velocity") == 1.0  # a 0.1 s tick moves the robot for 0.1 s
+    assert stepped_time_scale(SimpleNamespace(driver=2.0, control=10.0), "discrete") == 1.0
+    assert float(LatencyModel(2.0, 0.0, seed=3, scale=0.2)) == 2.0 * 0.2
+    a, b = LatencyModel(2.0, 0.5, seed=3), LatencyModel(2.0, 0.5, seed=3, scale=0.2)
+    assert all(abs(float(a) * 0.2 - float(b)) < 1e-12 for _ in range(5))  # same draws, scaled

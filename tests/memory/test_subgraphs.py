@@ -134,3 +134,17 @@ def test_label_match_by_similarity_threshold():
     strict = decompose(snap, TaskSpec("find the bed", ("bed",)), similarity, label_match_threshold=1.0)
     loose = decompose(snap, TaskSpec("find the bed", ("bed",)), similarity, label_match_threshold=0.5)
     assert strict[0].kind == "remaining" and loose[0].kind == "target"
+
+
+def test_a_described_target_subgraph_carries_the_nodes_mapped_near_it():
+    """ "the bed near the lamp": the lamp (1.6 m from the bed's box) is in no anchor of the bed's
+    subgraph, but on the map beside it; the toilet 2.6 m off is not carried (context_m 2.5)."""
+    snap = snapshot_from(EDGES, LABELS)
+    described = TaskSpec("the bed near the lamp", ("bed",), ("lamp",), relations=(("bed", "near", "lamp"),))
+    target = decompose(snap, described, similarity, k=5)[0]
+    assert target.kind == "target" and target.focus_object_id == 0
+    assert 2 not in target.object_ids and [o.id for o in target.context] == [2]
+    assert target.signature[-1] == ((2, "lamp"),)  # a node mapped nearby makes the subgraph due again
+    plain = decompose(snap, TASK, similarity, k=5)[0]
+    assert plain.context == () and plain.signature == target.signature[:-1]
+    assert decompose(snap, described, similarity, k=5, context_m=0.0)[0].context == ()

@@ -165,3 +165,36 @@ def test_the_offline_verifier_waits_for_the_related_object():
     verifier = OfflineVerifier(ReasoningConfig())
     result = verifier.verify(graph([node(1, "armchair", (0, 0)), node(3, "sofa", (0, 2.0), (2.0, 0.9))]), TASK)
     assert not result.found and result.reason == RELATION_UNKNOWN
+
+
+@dataclass(frozen=True)
+class GraphWithContext(Graph):
+    context: tuple = ()
+
+
+def test_a_relation_holds_on_a_node_mapped_nearby_that_no_image_of_the_subgraph_shows():
+    """The floor lamp beside the armchair was mapped from another viewpoint: the subgraph's own
+    anchors show the armchair and the sofa only, its context holds the lamp."""
+    verifier = OfflineVerifier(ReasoningConfig())
+    scene = _living_room_scene()
+    sofa = node(3, "sofa", (0, 2.0), (2.0, 0.9), anchors=(1, 7))
+    shown = graph([scene[0], sofa])
+    alone = verifier.verify(shown, TASK)
+    assert not alone.found and alone.reason == RELATION_UNKNOWN
+    lamp = node(2, "floor_lamp", (0.9, 0), (0.3, 0.3), (0.0, 1.6), anchors=(7,))  # seen with the sofa, elsewhere
+    with_map = GraphWithContext(shown.kind, shown.anchors, shown.objects, context=(lamp,))
+    result = verifier.verify(with_map, TASK)
+    assert result.found and result.hypothesis.object_id == 1, result.detail
+
+
+def test_a_node_observed_often_passes_the_offline_confidence_floor():
+    """Detectors score small and far objects low in every frame; many observations are evidence
+    the score is not (reasoning.offline.confident_observations)."""
+    verifier = OfflineVerifier(ReasoningConfig())
+    scene = _living_room_scene()
+    faint = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.35, n_obs=4,
+                 center=scene[0].center)
+    assert verifier.verify(graph([faint, *scene[1:3]]), TASK).reason == "low_confidence"
+    often = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.35, n_obs=12,
+                 center=scene[0].center)
+    assert verifier.verify(graph([often, *scene[1:3]]), TASK).found
