@@ -132,8 +132,10 @@ def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
                "(stepped-clock) time. Wall times depend on the machine and its load. On the stepped "
                "clock every reasoning call (decomposition or subgraph verification, offline or VLM) "
                "takes the modelled latency `reasoning.latency_s` +- `reasoning.latency_jitter_s` "
-               "(default 2.0 +- 0.5 s, a fast hosted VLM; seeded), so task times show what "
-               "asynchrony buys (compare the sync_reasoning preset)."), ""]
+               "(default 2.0 +- 0.5 s, a fast hosted VLM; seeded) of robot time: a call spans the "
+               "discrete actions a robot makes in that time (0.5 s each, so 4 for 2 s), which on the "
+               "stepped clock's 0.1 s ticks is 0.4 s (`mission.latency_time: clock` takes it in clock "
+               "seconds). Task times show what asynchrony buys (compare the sync_reasoning preset)."), ""]
 
     if main is not None and presets.get(main, {}).get("by_target"):
         lines += [f"## Success by target category ({main})", ""]
