@@ -18,17 +18,19 @@ Nothing here reads the mission context, sends a goal, ticks a tree or talks to a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Callable, Iterable, TypeVar
 
 import numpy as np
 
+from hiconav.decisions.cells import camera_of, furniture_boxes, wall_heights
 from hiconav.decisions.config import VerifySettings
 from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, evidence_verdict, for_good, frames_since,
                                             deferred, judge_frames, restart_unseen, support_ids,
-                                            target_labels)
+                                            target_labels, timeout_verdict)
 from hiconav.decisions.geometry import facing
-from hiconav.decisions.viewing import ViewMove, blockers, fallback_cell, nearer_candidate, next_view_move, stall_matters
+from hiconav.decisions.viewing import (ViewMove, blockers, close_distance, fallback_cell, nearer_candidate, next_view_move,
+                                      sight, stall_matters)
 from hiconav.types import Goal, wrap_angle
 
 #: goal tolerances (m): a closer cell, a view cell through unknown floor, a glance in place
@@ -39,13 +41,19 @@ C = TypeVar("C")
 
 @dataclass(frozen=True)
 class Judgement:
-    """The verdict the frames judged so far give (``verdict``); for a confirmed one, ``found``:
-    the supporting node that more fresh views observed than the candidate (None: the candidate
-    is the object found) and ``log``: the text saying so ("" with none)."""
+    """The verdict the frames judged so far give (``verdict``); for a confirmed one, ``node``:
+    the memory node of the supporting object that more fresh views observed than the candidate
+    (None: the candidate is the object found), ``log``: the text saying so ("" with none), and
+    ``feedback``: the behaviour's feedback text."""
 
     verdict: Verdict
-    found: int | None = None
+    node: Any = None
     log: str = ""
+    feedback: str = ""
+
+    @property
+    def confirmed(self) -> bool:
+        return self.verdict.outcome == "confirmed"
 
 
 @dataclass(frozen=True)
@@ -72,11 +80,16 @@ class Switch:
 
 @dataclass(frozen=True)
 class Posting:
-    """How a verdict is posted: excluded for good (``permanent``), and due again once the map
+    """How a verdict is posted (``MissionContext.reject``'s flags): excluded for good
+    (``permanent``), due again once observed as a target again (``requalify``) or once the map
     around the candidate has grown (``remap``)."""
 
     permanent: bool
+    requalify: bool
     remap: bool
+
+    def flags(self) -> dict[str, bool]:
+        return {"permanent": self.permanent, "requalify": self.requalify, "remap": self.remap}
 
 
 class Verification:
@@ -102,12 +115,17 @@ class Verification:
         """Frames are judged: the robot is close, or a frame showed the candidate."""
         return self.close or bool(self.tally.in_view)
 
-    def judge(self, settings: VerifySettings, memory: Any, grid: Any, cand: Any, task_targets: Iterable[str] | None,
-              label: str) -> Judgement | None:
-        """Judge the memory's anchors newer than the last judged (``confirmation.judge_frames``,
-        against the ``memory`` snapshot's objects and the map ``grid``) for the candidate ``cand``
-        (its current box and observations; read as ``label`` when it was chosen), and give the
-        verdict of the frames so far (``evidence_verdict``); None: judge on."""
+    def judge(self, settings: VerifySettings, gap: float, ring: float, memory: Any, grid: Any, cand: Any,
+              task_targets: Iterable[str] | None, label: str) -> Judgement | None:
+        """Whether the robot, ``gap`` m from the candidate's box, is close (``viewing.close_distance``
+        for the view ring ``ring``); if so, judge the memory's anchors newer than the last judged
+        (``confirmation.judge_frames``, against the ``memory`` snapshot's objects and the map
+        ``grid``) for the candidate ``cand`` (its current box and observations; read as ``label``
+        when it was chosen), and give the verdict of the frames so far (``evidence_verdict``);
+        None: judge on."""
+        self.close = gap <= close_distance(settings, ring)
+        if not self.close:
+            return None
         anchors, objects = tuple(getattr(memory, "anchors", ()) or ()), memory.objects
         frames, self.last_anchor = frames_since(anchors, self.last_anchor)
         targets, support, hiding = evidence_inputs(settings, memory, task_targets, cand)
@@ -115,21 +133,28 @@ class Verification:
             self.tally = judge_frames(self.tally, frames, objects=objects, grid=grid, center=cand.center,
                                       box_min=cand.box_min, box_max=cand.box_max, support=support, hiding=hiding,
                                       targets=targets, near=settings.near_view_distance)
-        verdict = evidence_verdict(settings, self.tally, label=label, n_obs=cand.n_obs, objects=objects, support=support)
+        verdict = evidence_verdict(settings, self.tally, label=label, n_obs=cand.n_obs, objects=objects,
+                                   support=support)
         if verdict is None or verdict.outcome != "confirmed":
             return None if verdict is None else Judgement(verdict)
         found = confirmed_node(self.tally, cand.object_id)
-        if found is None:
-            return Judgement(verdict)
-        return Judgement(verdict, found[0], f"#{cand.object_id} confirmed by views of #{found[0]} ({found[1]} of "
-                                            f"them): going to #{found[0]}")
+        node = None if found is None else next((o for o in objects if o.id == found[0]), None)
+        said = f"confirmed {cand.label} #{cand.object_id}: {verdict.reason}"
+        if node is None:
+            return Judgement(verdict, feedback=said)
+        return Judgement(verdict, node, f"#{cand.object_id} confirmed by views of #{found[0]} ({found[1]} of them): "
+                                        f"going to #{found[0]}", said)
 
-    def next_move(self, settings: VerifySettings, *, sent: bool, state: str, cell: np.ndarray | None,
-                  stalled: Callable[[], bool]) -> ViewMove:
-        """The next move (``viewing.next_view_move``), with the state it changes applied: ``sent``
-        (a goal was sent), ``state`` (its navigation state), ``cell`` (the cell last sent, or
-        None), ``stalled`` (reads the stall clock, only where ``viewing.stall_matters``: reading
-        it restarts it)."""
+    def next_move(self, settings: VerifySettings, *, elapsed: float, sent: bool, state: str, cell: np.ndarray | None,
+                  mapped: bool, stalled: Callable[[], bool]) -> ViewMove:
+        """The next move (``viewing.next_view_move``), with the state it changes applied, or the
+        timeout's deferral (``confirmation.timeout_verdict``: ``elapsed`` clock s since the start):
+        ``sent`` (a goal was sent), ``state`` (its navigation state), ``cell`` (the cell last sent,
+        or None), ``mapped`` (a map and the robot's pose are known: without them no closer cell,
+        way through unknown floor or map deferral goes), ``stalled`` (reads the stall clock, only
+        where ``viewing.stall_matters``: reading it restarts it)."""
+        if (late := timeout_verdict(settings, elapsed)) is not None:
+            return ViewMove(reason=late.reason)
         move = next_view_move(settings, close=self.close, sent=sent, state=state, unseen=self.tally.unseen,
                               excluded=len(self.excluded), has_cell=cell is not None, closing=self.closing,
                               stalled=stall_matters(self.close, sent, state) and stalled())
@@ -137,7 +162,7 @@ class Verification:
             self.excluded.append(cell)
         self.tally = restart_unseen(self.tally) if move.reset_unseen else self.tally
         self.closing = self.closing and not move.stop_closing
-        return move
+        return move if mapped else replace(move, tries=tuple(k for k in move.tries if k in ("view", "glance")))
 
     def glance(self, pose: Any, cand: Any, glance_deg: float) -> Goal:
         """The goal of the next glance from where the robot stands (``pose``: x, y world):
@@ -147,19 +172,20 @@ class Verification:
         self.glances += 1
         return Goal(pose.x, pose.y, wrap_angle(face + offset), GLANCE_TOLERANCE, "look", cand.object_id)
 
-    def fallback(self, kind: str, settings: VerifySettings, grid: Any, cand: Any, robot_xy: np.ndarray, *, gap: float,
-                 ring: float, furniture: list[tuple[np.ndarray, np.ndarray]] | None,
-                 heights: tuple[float, float] | None, view: tuple[np.ndarray, float, np.ndarray, np.ndarray] | None,
-                 label: str) -> CellGoal | None:
-        """The goal of a "closer" or "unknown" move toward the candidate ``cand`` (read as ``label``
-        when it was chosen; ``viewing.fallback_cell``, with the moves made so far and the cells set
-        aside), counted as made; None when it cannot go. ``gap``: the robot's distance (m) to the
-        box."""
+    def fallback(self, kind: str, settings: VerifySettings, grid: Any, memory: Any, cand: Any, robot_xy: np.ndarray,
+                 gap: float, ring: float, task_targets: Iterable[str] | None, label: str) -> CellGoal | None:
+        """The goal of a "closer" or "unknown" move (any other ``kind``: None) toward the candidate ``cand`` (read as ``label``
+        when it was chosen; ``viewing.fallback_cell`` with the moves made so far, the cells set
+        aside, the ``memory`` snapshot's furniture, wall heights and, through unknown floor, the
+        boxes that may hide it), counted as made; None when it cannot go. ``gap``: the robot's
+        distance (m) to the box; ``ring``: the view ring."""
         closer, object_id = kind == "closer", cand.object_id
+        view = None if closer else sight_of(settings, memory, task_targets, cand)
         cell = fallback_cell(kind, settings, grid, cand.box_min, cand.box_max, robot_xy, gap=gap, ring=ring,
                              excluded=self.excluded, n_obs=cand.n_obs,
-                             moves=self.closer_moves if closer else self.unknown_moves, furniture=furniture,
-                             heights=heights, view=None if closer else view)
+                             moves=self.closer_moves if closer else self.unknown_moves,
+                             furniture=furniture_boxes(memory, object_id),
+                             heights=wall_heights(memory, float(np.asarray(cand.box_max)[2])), view=view)
         if cell is None:
             return None
         self.closer_moves, self.unknown_moves = self.closer_moves + closer, self.unknown_moves + (not closer)
@@ -192,6 +218,13 @@ def hiding(settings: VerifySettings, memory: Any, task_targets: Iterable[str] | 
     return evidence_inputs(settings, memory, task_targets, cand)[2]
 
 
+def sight_of(settings: VerifySettings, memory: Any, task_targets: Iterable[str] | None,
+             cand: Any) -> tuple[np.ndarray, float, np.ndarray, np.ndarray] | None:
+    """``approach_cell``'s ``sight`` argument for the candidate ``cand`` (``viewing.sight``, with
+    the ``memory`` snapshot's camera and the boxes that may hide the candidate)."""
+    return sight(cand.center, camera_of(memory), hiding(settings, memory, task_targets, cand))
+
+
 def node_fields(node: Any) -> tuple[str, np.ndarray, np.ndarray, np.ndarray, float, int]:
     """A memory object ``node``'s label, centre (3,) world float64, box min and max (3,) world (as
     stored), confidence and observations: a candidate's fields as the memory has them now (the
@@ -206,11 +239,12 @@ def view_feedback(label: str, object_id: int, another: bool) -> str:
 
 
 def move_verdict(move: ViewMove, said: str | None) -> Verdict | None:
-    """The deferral a ``ViewMove`` ends in: its ``reason``, or, when its tries came to "remap"
-    (``said``: the feedback of the try that went), no reachable view point until the map grows."""
+    """The deferral a ``ViewMove`` ends in: its ``reason``; or, when none of its tries went
+    (``said``: the feedback of the one that went, None: none) and the last was "remap", no
+    reachable view point until the map around the candidate grows; else None."""
     if move.reason is not None:
         return deferred(move.reason)
-    return deferred("no reachable view point", remap=True) if said == "remap" else None
+    return deferred("no reachable view point", remap=True) if said is None and "remap" in move.tries else None
 
 
 def nearer_switch(settings: VerifySettings, here: float, others: Iterable[tuple[float, C]], object_id: int) -> Switch | None:
@@ -231,9 +265,9 @@ def posting(settings: VerifySettings, verdict: Verdict, object_id: int, rejectio
     ``confirmation.for_good`` says, this deferral counted."""
     remap = verdict.remap and not verdict.permanent and can_remap
     count = sum(1 for i, _ in rejections if i == object_id) - remaps + 1
-    return Posting(for_good(settings, verdict.permanent, remap, count), remap)
+    return Posting(for_good(settings, verdict.permanent, remap, count), verdict.requalify, remap)
 
 
 __all__ = ["CLOSER_TOLERANCE", "CellGoal", "GLANCE_TOLERANCE", "Judgement", "Posting", "Switch", "UNKNOWN_TOLERANCE",
            "Verification", "evidence_inputs", "hiding", "move_verdict", "nearer_switch", "node_fields",
-           "posting", "view_feedback"]
+           "posting", "sight_of", "view_feedback"]

@@ -23,13 +23,11 @@ from hiconav.trees.registry import register_behaviour
 @register_behaviour()
 class VerifyTarget(_GoToObject):
     """Go within ``verify_distance`` of the candidate, facing it, and confirm it with fresh views,
-    glancing ``glance_deg`` left and right of it so that each glance makes an anchor. The state of
-    the verification and its next move are ``verification.Verification``'s; a verdict rejects or
-    defers the candidate (``MissionContext.reject``); a confirmed one is written as the target."""
+    glancing ``glance_deg`` left and right of it so that each glance makes an anchor. The state and
+    the next steps are ``verification.Verification``'s; a verdict rejects or defers the candidate
+    (``MissionContext.reject``); a confirmed one is written as the target."""
 
-    SETTINGS = "verify"
-    WRITES = ("target",)
-    READS = ()
+    SETTINGS, WRITES, READS = "verify", ("target",), ()
 
     def initialise(self) -> None:
         self._switches = 0  # switches to a nearer candidate since the tree started this behaviour
@@ -50,8 +48,7 @@ class VerifyTarget(_GoToObject):
         return self.param("view_ray_weight")
 
     def _sight(self, cand: Candidate) -> tuple[np.ndarray, float, np.ndarray, np.ndarray] | None:
-        return view.sight(cand.center, self._camera(), verif.hiding(self.settings, self.context.memory,
-                                                                    self._targets(), cand))
+        return verif.sight_of(self.settings, self.context.memory, self._targets(), cand)
 
     def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
         return view.seen_from_node(cand.center, self.context.memory, self.context.object(cand.object_id), distance)
@@ -62,14 +59,12 @@ class VerifyTarget(_GoToObject):
     def _targets(self) -> list[str] | None:
         return self.context.task.targets if self.context.task is not None else None
 
-    # -- polling ---------------------------------------------------------------------------------
     def _reject(self, verdict: conf.Verdict) -> Status:
         """Post a rejection or deferral (``verdict``) of the candidate; FAILURE."""
         if self._cand is not None:
             ctx, oid = self.context, self._cand.object_id
             post = verif.posting(self.settings, verdict, oid, ctx.rejections, ctx.remaps.get(oid, 0), ctx.can_remap(oid))
-            ctx.reject(oid, verdict.reason, permanent=post.permanent, defer_s=self.param("defer_s"),
-                       requalify=verdict.requalify, remap=post.remap)
+            ctx.reject(oid, verdict.reason, defer_s=self.param("defer_s"), **post.flags())
         self.feedback_message = verdict.feedback
         return Status.FAILURE
 
@@ -89,20 +84,8 @@ class VerifyTarget(_GoToObject):
         self.feedback_message = switch.feedback
         return Status.RUNNING
 
-    def _judge(self, current: Candidate, obj: object) -> Status | None:
-        """Judge the new frames of ``current`` (close to it); its verdict's status, or None."""
-        ctx = self.context
-        judged = self._v.judge(self.settings, ctx.memory, ctx.grid, current, self._targets(), self._cand.label)
-        if judged is None or judged.verdict.outcome != "confirmed":
-            return None if judged is None else self._reject(judged.verdict)
-        if (node := None if judged.found is None else ctx.object(judged.found)) is not None:
-            ctx.log(judged.log)
-        self.write("target", current if node is None else ctx.candidate_of(node, current.source, float(node.confidence)))
-        self.feedback_message = f"confirmed {obj.label} #{obj.id}: {judged.verdict.reason}"
-        return Status.SUCCESS
-
     def _try(self, kind: str, current: Candidate, another: bool) -> str | None:
-        """Send the goal of a ``ViewMove`` try: its feedback, or None when it cannot go."""
+        """Send the goal of a ``ViewMove`` try: its feedback, or None when it cannot go ("remap")."""
         ctx, cand, pose = self.context, self._cand, self.context.pose
         if kind == "view":
             sent = self._send(current, self._ring(current))
@@ -110,12 +93,9 @@ class VerifyTarget(_GoToObject):
         if kind == "glance":
             self._seq = ctx.send_goal(self._v.glance(pose, current, self.param("glance_deg")))
             return ""
-        if ctx.grid is None or pose is None or kind == "remap":
-            return None if ctx.grid is None or pose is None else kind
-        goal = self._v.fallback(kind, self.settings, ctx.grid, current, np.array([pose.x, pose.y]),
-                                gap=ctx.distance_to_box(current.box_min, current.box_max), ring=self._ring(current),
-                                furniture=self._furniture(current), heights=self._wall_heights(current),
-                                view=self._sight(current), label=cand.label)
+        goal = self._v.fallback(kind, self.settings, ctx.grid, ctx.memory, current, np.array([pose.x, pose.y]),
+                                ctx.distance_to_box(current.box_min, current.box_max), self._ring(current),
+                                self._targets(), cand.label)
         if goal is not None:
             self._go_to_cell(current, goal.cell, goal.tolerance, through_unknown=goal.through_unknown)
             ctx.log(goal.log)
@@ -123,12 +103,10 @@ class VerifyTarget(_GoToObject):
 
     def update(self) -> Status:
         ctx, cand = self.context, self._cand
-        if cand is None:
-            self.feedback_message = "no target to verify"
-            return Status.FAILURE
-        if not ctx.verify:
-            self.feedback_message = "verification disabled: candidate accepted as is"
-            return Status.SUCCESS
+        if cand is None or not ctx.verify:
+            self.feedback_message, status = (("no target to verify", Status.FAILURE) if cand is None else
+                                             ("verification disabled: candidate accepted as is", Status.SUCCESS))
+            return status
         if (obj := ctx.object(cand.object_id)) is None:
             return self._reject(conf.Verdict("rejected", "object node disappeared from memory"))
         if (switched := self._switch(obj, cand)) is not None:
@@ -136,18 +114,23 @@ class VerifyTarget(_GoToObject):
         current = Candidate(cand.object_id, *verif.node_fields(obj), cand.source)
         if (flipped := conf.label_verdict(self._targets(), obj.label, cand.source)) is not None:
             return self._reject(flipped)
-        # judged every tick, for the current box: the box grows as it is seen
-        gap = ctx.distance_to_box(current.box_min, current.box_max)
-        self._v.close = gap <= view.close_distance(self.settings, self._ring(current))
-        if self._v.close and (judged := self._judge(current, obj)) is not None:
-            return judged
-        if (late := conf.timeout_verdict(self.settings, ctx.now() - self._v.start)) is not None:
-            return self._reject(late)
+        gap, ring = ctx.distance_to_box(current.box_min, current.box_max), self._ring(current)
+        judged = self._v.judge(self.settings, gap, ring, ctx.memory, ctx.grid, current, self._targets(), cand.label)
+        if judged is not None and not judged.confirmed:
+            return self._reject(judged.verdict)
+        if judged is not None:
+            if judged.node is not None:
+                ctx.log(judged.log)
+            self.write("target", current if judged.node is None else
+                       ctx.candidate_of(judged.node, current.source, float(judged.node.confidence)))
+            self.feedback_message = judged.feedback
+            return Status.SUCCESS
         state = "pending" if self._seq is None else ctx.nav_state(self._seq)
-        move = self._v.next_move(self.settings, sent=self._seq is not None, state=state,
-                                 cell=getattr(self, "_cell", None), stalled=self._stalled)
-        said = None if move.reason else next((t for t in (self._try(k, current, move.another_cell)
-                                                          for k in move.tries) if t is not None), "")
+        move = self._v.next_move(self.settings, elapsed=ctx.now() - self._v.start, sent=self._seq is not None,
+                                 state=state, cell=getattr(self, "_cell", None),
+                                 mapped=ctx.grid is not None and ctx.pose is not None, stalled=self._stalled)
+        said = None if move.reason is not None else next(
+            (t for t in (self._try(k, current, move.another_cell) for k in move.tries) if t is not None), None)
         if (ended := verif.move_verdict(move, said)) is not None:
             return self._reject(ended)
         self.feedback_message = said or f"verifying {cand.label} #{cand.object_id}"
