@@ -158,9 +158,9 @@ class MissionContext:
         """True while a candidate is rejected or deferred.
 
         A deferral made with ``requalify`` lapses early once the node has gained
-        ``requalify_observations`` observations and carries a target label again: a label flip
-        deferred a real armchair for 30 s of a 50 s episode while the detector went on reading it
-        as an armchair (val/6/1). Only label flips requalify: an unreachable or unconfirmed
+        ``requalify_observations`` observations and carries a target label again: a label that
+        flipped once should not keep a real object waiting while the detector goes on reading it
+        as the target. Only label flips requalify: an unreachable or unconfirmed
         candidate is observed again at once from where the robot stands."""
         if object_id in self.rejected:
             return True
@@ -252,10 +252,9 @@ class MissionContext:
                        and o.id not in seen]
             if self.pose is not None:
                 # nearest first: verification decides whether a label match is the target, and the
-                # way to a far one and back is what a wrong order costs. Ranked by evidence
-                # (confidence x observations), a plant seen five times 4 m off went before one
-                # seen once 2.2 m off, both real (Gibson Klickitat/0/3: 5.75 m driven, not 3.0);
-                # evidence first, then distance, gained less on Gibson (53.7 against 53.8 SPL)
+                # way to a far one and back is what a wrong order costs; ranked by evidence
+                # (confidence x observations), a far, often-seen match went before a near one seen
+                # once, both real (evidence first, then distance, gained less on Gibson)
                 matches.sort(key=lambda o: (self.distance_to_box(np.asarray(o.box_min), np.asarray(o.box_max)), o.id))
             else:
                 matches.sort(key=lambda o: (-o.confidence * o.n_obs, o.id))

@@ -7,7 +7,12 @@ its reason); the mission tree's behaviours (``trees/behaviours/``) only poll the
 they decide. Nothing here ticks a tree, sends a message or talks to an actor.
 
 - ``config``: every threshold, one typed field each (``hiconav config --describe``)
+- ``frontiers``: which frontier of the WTRP order to go to, spent viewpoints, pushes, squeezes,
+  the look-around and the idle clock (``Explore``)
+- ``viewing``: where to stand to see or verify an object (``VerifyTarget``)
+- ``confirmation``: what evidence confirms a candidate, and the verdict with its reason
+- ``approach``: the final ring, the straight-in step, the creep, when the robot is there
 - ``geometry``: approach cells, the 2D line of sight past walls, what an anchor's camera shows
-- ``progress``: the stall clock (no progress toward a goal)
 - ``cells``: the view or approach cell near a candidate's footprint, with its fallbacks
+- ``progress``: the stall clock (no progress toward a goal)
 """

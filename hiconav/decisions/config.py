@@ -66,6 +66,7 @@ class ExploreSettings(_Section):
     push_s: float = _f(6.0, "clock seconds a push may take before it counts as blocked", 0.1, 600.0)
     stall_s: float = _f(8.0, "a frontier goal the robot came no nearer to (by progress_m) for this long is "
                              "skipped: a passage the map shows open that the robot does not fit", 0.1, 600.0)
+    stall_near: float = _f(0.35, "within this of a frontier goal the robot is arriving, not stalled (m)", 0.0, 5.0)
     progress_m: float = _f(0.25, "coming this much nearer a goal is progress (stall and idle clocks, m)",
                            0.01, 5.0)
     squeeze: bool = _f(True, "with every frontier failed, try each once more through unknown floor on the "
@@ -161,6 +162,17 @@ class ApproachSettings(_Section):
                                      "way and the view from the ring are clear (0: always a ring cell)", 0.0, 5.0)
     stall_s: float = _f(6.0, "an approach cell the robot came no nearer to (by 0.25 m) for this long counts as "
                              "failed", 0.1, 600.0)
+    min_ring: float = _f(0.2, "no ring for an approach cell lies nearer the footprint than this (m)", 0.0, 5.0)
+    second_margin: float = _f(0.1, "a second ring lies at most this far inside the distance (m)", 0.0, 5.0)
+    strict_within: float = _f(1.0, "on the rings out to this, cells that see the footprint past every wall are "
+                                   "tried first (m; the success distance)", 0.0, 5.0)
+    creep_within: float = _f(1.0, "reached a cell of a ring out to this short of the ring: creep on rather than "
+                                  "drive to another cell (m)", 0.0, 5.0)
+    straight_step: float = _f(0.25, "the straight way in is checked this far past the ring: a step may end up to a "
+                                    "step inside it (the robot's forward step, m)", 0.0, 2.0)
+    min_points: int = _f(10, "with measure 'points', a node with fewer points is measured by its box", 1, 100000)
+    face_tolerance: float = _f(0.5, "the turn in place toward the target counts as reached this near where the "
+                                    "robot stands (m)", 0.0, 5.0)
 
 
 class ReturnSettings(_Section):

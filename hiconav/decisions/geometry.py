@@ -33,8 +33,7 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     distance to the robot plus ``centre_weight`` times its distance to the footprint's centre.
     With a weight, the cell lies in front of the object's middle rather than off one of its
     ends: from a cell near the end of a painting 0.9 m long the robot sees it at a grazing
-    angle past its wall, and on the ground truth such a cell is not a view point of it
-    (ProcTHOR val/42/1 stopped 0.64 m from the painting's end and 1.12 m from success).
+    angle past its wall, and such a cell is no view point of it.
     ``prefer_xy`` adds ``prefer_weight`` times the cell's distance to that point (a place the
     object was seen from; see ``VerifyTarget``). ``sight`` = (point (3,), camera height, lo,
     hi (m, 3)): when some candidate cells see the point over the boxes (``segments_blocked``
@@ -45,8 +44,7 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     when every cell is behind a wall). ``wall_heights`` = (camera height, the target's top): an
     occupied cell hides the footprint only where it stands as high as the line of sight there
     (``wall_clear``'s ``heights``), as the camera judges it; without them every occupied cell
-    is a wall, and an unlabelled 0.8 m cabinet at a sofa's end ruled out the cell the robot stood
-    on 0.67 m from the sofa (Gibson Leonardo/0/0 drove 1.2 m more to a cell by its middle).
+    is a wall, and low unlabelled furniture beside the object rules out the cells next to it.
     ``box_weight`` adds that many times the cell's distance to
     the footprint: for a ring wider than the success distance the nearest cell to the robot lies
     on the ring's edge, 1 m out, where the object's box error decides success (Gibson stopped
@@ -140,14 +138,13 @@ def wall_clear(grid: Any, cells_xy: np.ndarray, target_xy: np.ndarray,
 
     On a 2D map a table is as opaque as a wall, so a plain line-of-sight test lost every cell by
     objects on tables (an earlier attempt, reverted); furniture the memory knows is see-through
-    here and what stays opaque is what no object explains: walls. ProcTHOR val/93/0 stopped
-    0.65 m from a chair on the far side of a wall, 3.3 m from it by the ground truth.
+    here and what stays opaque is what no object explains: walls (a cell on the far side of a
+    wall is close to the object on the map and far from it on foot).
 
     ``heights`` = (start heights (n,) or one, end height) above the floor, with a grid that
     keeps obstacle heights (``top``): an occupied cell blocks only where its highest point comes
     within ``clearance`` of the line's height there, so a camera sees a sofa over an unlabelled
-    0.8 m table (Gibson Allensville/0/0 counted a sofa seen in 8 frames as in view in none). A
-    cell with no recorded height blocks."""
+    low table. A cell with no recorded height blocks."""
     state = np.asarray(grid.state)
     res, ox, oy = float(grid.resolution), float(grid.origin[0]), float(grid.origin[1])
     h, w = state.shape
@@ -204,9 +201,9 @@ def anchor_sees(anchor: Any, point: np.ndarray, blockers: tuple[np.ndarray, np.n
     line from the camera to it passes through none of them.
 
     A frame whose camera could not show the point says nothing about the object there: a tv
-    hung above the vertical field of view of a camera 1.2 m away, or a vase behind a chair
-    (ProcTHOR val/8/2, val/66/0), were rejected as 'detected in 0 of 8 frames' by a test that
-    looked at bearings only."""
+    hung above the vertical field of view of a camera 1.2 m away, or a vase behind a chair,
+    must not count as a frame that missed it (a test on bearings alone rejected real objects
+    as 'detected in 0 of 8 frames')."""
     T = np.asarray(anchor.T_world_cam, dtype=np.float64)
     pc = T[:3, :3].T @ (np.asarray(point, dtype=np.float64)[:3] - T[:3, 3])
     if pc[2] <= 1e-6:

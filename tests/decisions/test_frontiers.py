@@ -1,0 +1,170 @@
+"""Frontier following (hiconav.decisions.frontiers): small hand-built plans, poses and clocks."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from hiconav.decisions.config import ExploreSettings
+from hiconav.decisions.frontiers import (ExploreLedger, FrontierFollower, PlanView, facing_yaw, look_goal,
+                                         near_any, pick_frontier, pick_squeeze, push_goal, settle_reached)
+from hiconav.types import Frontier, Pose2D
+
+S = ExploreSettings()
+NO_START = ExploreSettings(start_look_turns=0)
+
+
+def _frontier(fid: int, viewpoint: tuple[float, float], centroid: tuple[float, float]) -> Frontier:
+    return Frontier(fid, np.array(centroid, dtype=np.float64), np.array(viewpoint, dtype=np.float64), 10)
+
+
+def _plan(*frontiers: Frontier, order: tuple[int, ...] | None = None, goal_id: int | None = None,
+          stamp: float = 0.0) -> PlanView:
+    return PlanView(tuple(frontiers), tuple(f.id for f in frontiers) if order is None else order, goal_id, stamp)
+
+
+def _ledger(**kw) -> ExploreLedger:
+    return ExploreLedger(kw.pop("last_frontier_time", 0.0), kw.pop("start_looks", 0), None, 0, **kw)
+
+
+def test_a_spot_within_the_radius_of_a_visited_one_counts_as_visited():
+    assert near_any(np.array([1.0, 1.0]), [(1.3, 1.0)], 0.4)
+    assert not near_any(np.array([1.0, 1.0]), [(1.5, 1.0)], 0.4)
+    assert not near_any(np.array([1.0, 1.0]), [], 0.4)
+
+
+def test_a_viewpoint_faces_its_frontier_unless_it_stands_on_it():
+    assert facing_yaw(np.array([0.0, 0.0]), np.array([0.0, 2.0])) == pytest.approx(math.pi / 2)
+    assert facing_yaw(np.array([0.0, 0.0]), np.array([0.1, 0.1])) is None
+
+
+def test_the_first_frontier_of_the_order_not_visited_is_picked():
+    plan = _plan(_frontier(0, (1, 0), (2, 0)), _frontier(1, (0, 1), (0, 2)), order=(1, 0))
+    fid, xy, yaw, push = pick_frontier(plan, set(), None, _ledger(), S)
+    assert (fid, push) == (1, False) and list(xy) == [0, 1] and yaw == pytest.approx(math.pi / 2)
+    assert pick_frontier(plan, {1}, None, _ledger(), S)[0] == 0
+    assert pick_frontier(plan, {0, 1}, None, _ledger(), S) is None
+
+
+def test_the_plans_goal_frontier_comes_first_when_the_order_lacks_it():
+    plan = _plan(_frontier(0, (1, 0), (2, 0)), _frontier(1, (0, 1), (0, 2)), order=(0,), goal_id=1)
+    assert pick_frontier(plan, set(), None, _ledger(), S)[0] == 1
+
+
+def test_a_frontier_seen_from_a_spent_viewpoint_far_from_the_robot_is_skipped():
+    plan = _plan(_frontier(0, (5, 0), (6, 0)), _frontier(1, (0, 1), (0, 2)))
+    ledger = _ledger(spent_viewpoints=[(5.1, 0.0)])
+    assert pick_frontier(plan, set(), Pose2D(0.0, 0.0, 0.0), ledger, S)[0] == 1
+    assert ledger.pushed_frontiers == []
+
+
+def test_a_spent_frontier_beside_the_robot_is_pushed_into_once_beyond_its_centroid():
+    plan = _plan(_frontier(0, (0.5, 0), (1, 0)))
+    ledger = _ledger(spent_viewpoints=[(0.5, 0.0)])
+    fid, xy, yaw, push = pick_frontier(plan, set(), Pose2D(0.0, 0.0, 0.0), ledger, S)
+    assert (fid, push) == (0, True) and yaw == pytest.approx(0.0)
+    assert xy == pytest.approx([1.0 + S.push_m, 0.0])
+    assert ledger.pushed_frontiers == [(1.0, 0.0)]
+    assert pick_frontier(plan, set(), Pose2D(0.0, 0.0, 0.0), ledger, S) is None  # pushed before
+
+
+def test_no_push_when_pushing_is_off_or_the_centroid_is_beyond_the_push_radius():
+    robot = Pose2D(0.0, 0.0, 0.0)
+    assert push_goal(np.array([1.0, 0.0]), robot, [], ExploreSettings(push_through=False)) is None
+    assert push_goal(np.array([S.push_radius + 0.1, 0.0]), robot, [], S) is None
+    assert push_goal(np.array([1.0, 0.0]), None, [], S) is None
+
+
+def test_a_push_into_a_centroid_under_the_robot_keeps_the_robots_heading():
+    goal, yaw = push_goal(np.array([0.05, 0.0]), Pose2D(0.0, 0.0, 1.0), [], S)
+    assert yaw == 1.0 and goal == pytest.approx([0.05 + S.push_m * math.cos(1.0), S.push_m * math.sin(1.0)])
+
+
+def test_a_reached_viewpoint_still_showing_a_frontier_on_a_later_plan_is_spent():
+    reached = [(np.array([1.0, 1.0]), 2.0)]
+    spent: list = []
+    waiting, new = settle_reached(reached, _plan(_frontier(7, (1.1, 1.0), (2, 1)), stamp=3.0), spent, S)
+    assert waiting == [] and new == [(1.0, 1.0)] and spent == [(1.0, 1.0)]
+
+
+def test_a_reached_viewpoint_waits_for_a_plan_made_spent_after_s_after_the_visit():
+    reached = [(np.array([1.0, 1.0]), 2.0)]
+    waiting, new = settle_reached(reached, _plan(_frontier(7, (1.0, 1.0), (2, 1)), stamp=2.1), [], S)
+    assert len(waiting) == 1 and new == []
+
+
+def test_a_reached_viewpoint_whose_frontier_cleared_is_forgotten_not_spent():
+    reached = [(np.array([1.0, 1.0]), 2.0)]
+    waiting, new = settle_reached(reached, _plan(_frontier(7, (4.0, 1.0), (5, 1)), stamp=3.0), [], S)
+    assert waiting == [] and new == []
+
+
+def test_a_failed_frontier_is_squeezed_toward_once_per_centroid():
+    plan = _plan(_frontier(0, (1, 0), (2, 0)), _frontier(1, (0, 1), (0, 2)))
+    ledger = _ledger(failed_frontiers={1})
+    fid, xy, yaw = pick_squeeze(plan, ledger, S)
+    assert fid == 1 and list(xy) == [0, 1] and ledger.squeezed_frontiers == [(0.0, 2.0)]
+    assert pick_squeeze(plan, ledger, S) is None
+    assert pick_squeeze(plan, _ledger(failed_frontiers={1}), ExploreSettings(squeeze=False)) is None
+
+
+def test_the_start_is_looked_around_in_quarter_turns_before_any_frontier():
+    f, ledger = FrontierFollower(), _ledger(start_looks=0)
+    plan = _plan(_frontier(0, (1, 0), (2, 0)))
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 1.0, plan, ledger, {}, ExploreSettings(start_look_turns=1))
+    assert step.goal.kind == "look" and step.goal.yaw == pytest.approx(math.pi / 2)
+    assert step.feedback == "looking around the start (0/1)" and ledger.last_frontier_time == 1.0
+    step = f.step("reached", Pose2D(0.0, 0.0, math.pi / 2), 2.0, plan, ledger, {}, ExploreSettings(start_look_turns=1))
+    assert ledger.start_looks == 1 and step.ended and step.goal.kind == "frontier" and step.goal.frontier == 0
+
+
+def test_a_frontier_goal_is_not_resent_while_its_viewpoint_stays_put():
+    f, ledger = FrontierFollower(), _ledger()
+    plan = _plan(_frontier(0, (3, 0), (4, 0)))
+    first = f.step(None, Pose2D(0.0, 0.0, 0.0), 1.0, plan, ledger, {}, NO_START)
+    again = f.step("active", Pose2D(0.1, 0.0, 0.0), 1.5, plan, ledger, {}, NO_START)
+    assert first.goal is not None and first.goal.tolerance == S.goal_tolerance and again.goal is None
+    moved = _plan(_frontier(0, (3, 1), (4, 1)))
+    assert f.step("active", Pose2D(0.2, 0.0, 0.0), 2.0, moved, ledger, {}, NO_START).goal is not None
+
+
+def test_a_frontier_goal_without_progress_for_stall_s_is_skipped_and_fails_for_the_mission():
+    f, ledger = FrontierFollower(), _ledger()
+    plan = _plan(_frontier(0, (3, 0), (4, 0)), _frontier(1, (0, 3), (0, 4)))
+    f.step(None, Pose2D(0.0, 0.0, 0.0), 0.0, plan, ledger, {}, NO_START)
+    f.step("active", Pose2D(0.0, 0.0, 0.0), 1.0, plan, ledger, {}, NO_START)
+    step = f.step("active", Pose2D(0.0, 0.0, 0.0), 1.0 + S.stall_s + 0.5, plan, ledger, {}, NO_START)
+    assert step.log == ("frontier #0: no progress for 8 s, skipped",)
+    assert step.ended and ledger.failed_frontiers == {0} and step.goal.frontier == 1
+
+
+def test_re_picking_a_failed_frontier_does_not_reset_the_idle_clock():
+    f, ledger = FrontierFollower(), _ledger(last_frontier_time=0.0, failed_frontiers={0})
+    f.step(None, Pose2D(0.0, 0.0, 0.0), 5.0, _plan(_frontier(0, (3, 0), (4, 0))), ledger, {}, NO_START)
+    assert ledger.last_frontier_time == 0.0
+
+
+def test_with_no_frontier_the_robot_looks_around_then_fails_after_max_idle_s():
+    f, ledger = FrontierFollower(), _ledger(last_frontier_time=0.0)
+    s = ExploreSettings(start_look_turns=0, look_turns=1)
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 1.0, _plan(), ledger, {}, s)
+    assert step.goal.kind == "look" and ledger.looks_here == 1 and step.feedback == "looking around"
+    step = f.step("reached", Pose2D(0.0, 0.0, 0.0), 2.0, _plan(), ledger, {}, s)
+    assert step.goal is None and step.feedback == "waiting for a frontier"  # turns per spot spent
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 1.0 + s.max_idle_s + 1.0, _plan(), ledger, {}, s)
+    assert step.status == "failure" and step.feedback == "no frontier left"
+
+
+def test_explored_out_with_deferred_candidates_makes_them_due_instead_of_failing():
+    f, ledger = FrontierFollower(), _ledger(last_frontier_time=0.0)
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 100.0, _plan(), ledger, {5: 130.0, 2: 120.0}, NO_START)
+    assert step.status == "running" and step.release_deferred and ledger.last_frontier_time == 100.0
+    assert step.log == ("no frontier left: deferred candidates [2, 5] are due now",)
+
+
+def test_a_look_is_a_quarter_turn_left_in_place():
+    goal = look_goal(Pose2D(1.0, 2.0, math.pi))
+    assert (goal.kind, goal.x, goal.y, goal.frontier) == ("look", 1.0, 2.0, None)
+    assert goal.yaw == pytest.approx(-math.pi / 2)
