@@ -158,6 +158,11 @@ class Verdict:
     def permanent(self) -> bool:
         return self.outcome == "rejected"
 
+    @property
+    def feedback(self) -> str:
+        """The feedback text of a rejection or deferral: "rejected: <reason>" or "deferred: <reason>"."""
+        return f"{'rejected' if self.permanent else 'deferred'}: {self.reason}"
+
 
 def deferred(reason: str, requalify: bool = False, remap: bool = False) -> Verdict:
     """A deferral with its ``reason``."""

@@ -125,6 +125,13 @@ def seen_from(center: np.ndarray, anchors: Iterable[Any], anchor_ids: set[int], 
     return centre + u * min(float(np.hypot(*(best - centre))), distance)
 
 
+def seen_from_node(center: np.ndarray, memory: Any, node: Any, distance: float) -> np.ndarray | None:
+    """``seen_from`` for the memory object ``node`` (None: unknown) with the anchors of the
+    ``memory`` snapshot (None: none) that observed it (its ``anchor_ids``)."""
+    anchors = getattr(memory, "anchors", ()) or ()
+    return seen_from(center, anchors, set(int(i) for i in getattr(node, "anchor_ids", ()) or ()), distance)
+
+
 def may_switch(settings: VerifySettings, switches: int, judging: bool) -> bool:
     """Whether a nearer candidate may replace the one under way: ``switch_margin`` is set, the
     robot is still on its way (``judging``: it is close, or a frame was judged), and fewer than
@@ -268,5 +275,6 @@ def next_view_move(settings: VerifySettings, *, close: bool, sent: bool, state: 
 
 
 __all__ = ["DONE", "MIN_HALF_FOV", "MIN_VIEW_RING", "ViewMove", "blockers", "box_distance", "close_distance",
-           "closer_cell", "fallback_cell", "may_switch", "may_try_unknown", "nearer_candidate", "next_view_move", "seen_from", "sight",
+           "closer_cell", "fallback_cell", "may_switch", "may_try_unknown", "nearer_candidate", "next_view_move", "seen_from",
+           "seen_from_node", "sight",
            "stall_matters", "through_unknown_cell", "view_ring"]
