@@ -11,6 +11,7 @@ they decide. Nothing here ticks a tree, sends a message or talks to an actor.
   the look-around and the idle clock (``Explore``)
 - ``viewing``: where to stand to see or verify an object (``VerifyTarget``)
 - ``confirmation``: what evidence confirms a candidate, and the verdict with its reason
+- ``verification``: one verification's state and next step (judge, move, glance, fallback)
 - ``approach``: the final ring, the straight-in step, the creep, when the robot is there
 - ``geometry``: approach cells, the 2D line of sight past walls, what an anchor's camera shows
 - ``cells``: the view or approach cell near a candidate's footprint, with its fallbacks
