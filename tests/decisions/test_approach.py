@@ -5,7 +5,6 @@ when it is done."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
@@ -13,16 +12,10 @@ import pytest
 from hiconav.decisions import approach as plan
 from hiconav.decisions.config import ApproachSettings
 
+from .fakes import Grid
+
 LO, HI = np.array([4.5, 4.5, 0.0]), np.array([5.5, 5.5, 0.8])  # a 1 m x 1 m object at (5, 5)
 CENTRE = np.array([5.0, 5.0, 0.4])
-
-
-@dataclass
-class Grid:
-    state: np.ndarray
-    inflated: np.ndarray
-    origin: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    resolution: float = 0.1
 
 
 def room(*walls: tuple[slice, slice]) -> Grid:

@@ -9,7 +9,9 @@ import numpy as np
 
 from hiconav.decisions import confirmation as conf
 from hiconav.decisions.config import VerifySettings
-from hiconav.types import CameraIntrinsics, Pose2D, camera_pose_from_base
+from hiconav.types import Pose2D, camera_pose_from_base
+
+from .fakes import Anchor
 
 S = VerifySettings(min_fresh_views=2, max_view_frames=8, unseen_view_frames=4)
 CENTRE = np.array([5.0, 5.0, 0.4])
@@ -24,15 +26,6 @@ class Node:
     box_max: np.ndarray
     confidence: float = 0.9
     n_obs: int = 1
-
-
-@dataclass(frozen=True)
-class Anchor:
-    id: int
-    T_world_cam: np.ndarray
-    object_ids: tuple = ()
-    labels_seen: tuple = ()
-    intrinsics: CameraIntrinsics = CameraIntrinsics.from_hfov(640, 480, 79.0)
 
 
 def node(oid: int, label: str, x: float, y: float, confidence: float = 0.9, n_obs: int = 1) -> Node:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -12,24 +12,8 @@ from hiconav.types import CameraIntrinsics, Pose2D, camera_pose_from_base
 
 
 
-@dataclass
-class FakeGrid:
-    state: np.ndarray
-    inflated: np.ndarray
-    origin: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    resolution: float = 0.1
-
-
-@dataclass
-class TightGrid(FakeGrid):
-    lethal: np.ndarray | None = None  # cells the robot centre cannot occupy (thinner than inflated)
-
-
-def open_grid(n: int = 100) -> FakeGrid:
-    """A 10 m x 10 m free room at 0.1 m, walls on the border."""
-    state = np.zeros((n, n), dtype=np.int8)
-    state[0, :] = state[-1, :] = state[:, 0] = state[:, -1] = 1
-    return FakeGrid(state, state == 1)
+from .fakes import Grid as FakeGrid
+from .fakes import open_grid
 
 
 @dataclass(frozen=True)
@@ -99,7 +83,7 @@ def test_cell_near_prefers_a_roomy_cell_and_falls_back_to_a_tight_one():
     assert cell is not None and abs(cell[1] - 5.0) < 0.6 and 4.0 <= cell[0] < 4.8  # the near side
     # furniture all round the object: every cell near it lies in the inflation margin, which only
     # the robot's radius clears (not lethal): the tight search still finds one
-    crowded = TightGrid(grid.state.copy(), grid.inflated.copy(), lethal=grid.state == 1)
+    crowded = FakeGrid(grid.state.copy(), grid.inflated.copy(), lethal=grid.state == 1)
     crowded.inflated[30:70, 30:70] = True
     tight = cell_near(crowded, lo, hi, np.array([2.0, 5.0]), 0.8, None)
     assert tight is not None and 4.0 <= tight[0] < 4.8

@@ -6,7 +6,7 @@ nearer candidate and how a verdict is posted."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -14,7 +14,9 @@ from hiconav.decisions import verification as verif
 from hiconav.decisions.confirmation import Verdict, deferred
 from hiconav.decisions.config import VerifySettings
 from hiconav.decisions.viewing import ViewMove, close_distance
-from hiconav.types import CameraIntrinsics, Pose2D, camera_pose_from_base
+from hiconav.types import Pose2D, camera_pose_from_base
+
+from .fakes import Grid, Anchor, Memory
 
 S = VerifySettings(min_fresh_views=2, max_view_frames=8, unseen_view_frames=4)
 CENTRE = np.array([5.0, 5.0, 0.4])
@@ -32,29 +34,6 @@ class Node:
     confidence: float = 0.9
     n_obs: int = 1
     anchor_ids: tuple = ()
-
-
-@dataclass(frozen=True)
-class Anchor:
-    id: int
-    T_world_cam: np.ndarray
-    object_ids: tuple = ()
-    labels_seen: tuple = ()
-    intrinsics: CameraIntrinsics = CameraIntrinsics.from_hfov(640, 480, 79.0)
-
-
-@dataclass
-class Memory:
-    objects: list
-    anchors: list = field(default_factory=list)
-
-
-@dataclass
-class Grid:
-    state: np.ndarray
-    inflated: np.ndarray
-    origin: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    resolution: float = 0.1
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ point on the line it was seen along, the closer cell, and the next move of a ver
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -13,17 +13,11 @@ from hiconav.decisions import viewing as view
 from hiconav.decisions.config import VerifySettings
 from hiconav.types import Pose2D, camera_pose_from_base
 
+from .fakes import Grid
+
 S = VerifySettings()
 LO, HI = np.array([4.5, 4.5, 0.0]), np.array([5.5, 5.5, 0.8])  # a 1 m x 1 m object at (5, 5)
 CENTRE = np.array([5.0, 5.0, 0.4])
-
-
-@dataclass
-class Grid:
-    state: np.ndarray
-    inflated: np.ndarray
-    origin: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    resolution: float = 0.1
 
 
 def room() -> Grid:
