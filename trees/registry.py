@@ -45,6 +45,7 @@ class Param:
     blackboard: bool = True
     doc: str = ""
     finite: bool = True
+    items: type | None = None  # a list's element type (float: finite numbers within the bounds)
 
     @property
     def required(self) -> bool:
@@ -65,6 +66,12 @@ class Param:
             ok = isinstance(value, expected)
         if not ok:
             return f"expected {expected.__name__}, got {type(value).__name__} {value!r}"
+        if expected is list and self.items is not None:
+            for i, item in enumerate(value):
+                problem = Param(self.items, minimum=self.minimum, maximum=self.maximum, finite=self.finite).check(item)
+                if problem is not None:
+                    return f"item {i}: {problem}"
+            return None
         if expected is float and self.finite and not math.isfinite(value):
             return f"{value!r} is not a finite number"
         if self.minimum is not None and value < self.minimum:
@@ -107,15 +114,16 @@ def settings_params(section: str | None) -> dict[str, Param]:
     model = DecisionsConfig.model_fields[section].annotation
     out: dict[str, Param] = {}
     for key, info in model.model_fields.items():  # type: ignore[union-attr]
-        annotation, choices = info.annotation, None
+        annotation, choices, items = info.annotation, None, None
         if get_origin(annotation) is Literal:
             choices = get_args(annotation)
             annotation = type(choices[0])
         elif get_origin(annotation) is list:
+            items = (get_args(annotation) or (None,))[0]
             annotation = list
         lo = next((m.ge for m in info.metadata if getattr(m, "ge", None) is not None), None)
         hi = next((m.le for m in info.metadata if getattr(m, "le", None) is not None), None)
-        out[key] = Param(annotation, FROM_SETTINGS, minimum=lo, maximum=hi, choices=choices,
+        out[key] = Param(annotation, FROM_SETTINGS, minimum=lo, maximum=hi, choices=choices, items=items,
                          doc=f"{info.description} (default: decisions.{section}.{key})")
     return out
 

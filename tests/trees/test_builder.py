@@ -113,3 +113,13 @@ def test_user_behaviour_by_import_path(tmp_path: Path):
 def test_unknown_tree_name_is_an_error():
     with pytest.raises(TreeError):
         load_tree("no_such_mission_anywhere")
+
+
+def test_a_list_setting_override_checks_each_item(tmp_path: Path):
+    f = tmp_path / "m.yaml"
+    f.write_text("root:\n  Approach:\n    settle_rings: [1.0, wide]\n")
+    with pytest.raises(TreeError, match=r"settle_rings: item 1: expected float") as info:
+        load_tree(f)
+    assert info.value.line == 3
+    f.write_text("root:\n  Approach:\n    settle_rings: [1.0, 1.4]\n")
+    assert load_tree(f).root.params == {"settle_rings": [1.0, 1.4]}
