@@ -134,18 +134,21 @@ def relation_holds(relation: str, a: BoxLike, b: BoxLike) -> bool:
 
 
 # ---------------------------------------------------------------------------------------- rooms
-def infer_rooms(objects: Sequence[BoxLike]) -> dict[int, tuple[str | None, float]]:
+def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = ()) -> dict[int, tuple[str | None, float]]:
     """Object id -> (inferred room type or None, its evidence score) for every object.
 
     An object's room scores sum, over the objects co-visible with it (a common anchor) within
-    ``ROOM_REACH_M`` and over itself, each cue weight x exp(-gap / ROOM_DECAY_M)."""
+    ``ROOM_REACH_M`` and over itself, each cue weight x exp(-gap / ROOM_DECAY_M). Objects whose
+    label is in ``ignore`` give no cue: for "the tv in the bedroom" the tvs are what the
+    description tells apart, so a tv's own "living room" cue must not decide which room it is in."""
     out: dict[int, tuple[str | None, float]] = {}
     anchors = {o.id: set(getattr(o, "anchor_ids", ()) or ()) for o in objects}
+    skip = {str(t).strip().lower().replace(" ", "_") for t in ignore}
     for o in objects:
         scores: dict[str, float] = {}
         for other in objects:
             cues = ROOM_CUES.get(other.label)
-            if not cues:
+            if not cues or other.label.strip().lower().replace(" ", "_") in skip:
                 continue
             if other.id != o.id and not (anchors[o.id] & anchors[other.id]):
                 continue
@@ -192,7 +195,7 @@ def ground(candidate: BoxLike, objects: Sequence[BoxLike], relations: Sequence[S
     related object ("the floor lamp in the living room") are checked one level down, on the node
     that satisfied the target's relation. Holds only when every relation holds.
     """
-    rooms = rooms if rooms is not None else infer_rooms(objects)
+    rooms = rooms if rooms is not None else infer_rooms(objects, ignore=targets)
     rels = target_relations(relations, targets)
     if not rels:
         return Grounding(candidate.id, "holds", ("no relation to check",))

@@ -245,7 +245,7 @@ class OfflineVerifier:
         described = bool(target_relations(task.relations, task.targets))
         objects = list(subgraph.objects)
         context = list(getattr(subgraph, "context", ()) or ())
-        rooms = infer_rooms(objects + context) if described else None
+        rooms = infer_rooms(objects + context, ignore=task.targets) if described else None
         groundings: dict[int, Any] = {}
         for obj in subgraph.objects:
             score, target = self._match(obj.label, task.targets)

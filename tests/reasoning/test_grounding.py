@@ -198,3 +198,14 @@ def test_a_node_observed_often_passes_the_offline_confidence_floor():
     often = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.35, n_obs=12,
                  center=scene[0].center)
     assert verifier.verify(graph([often, *scene[1:3]]), TASK).found
+
+
+def test_the_described_category_gives_no_room_cue_of_its_own():
+    """ "the tv in the bedroom": a tv is a living-room cue, but the tvs are what the description
+    tells apart, so a tv facing a dresser is in the bedroom, not in the living room its own label
+    suggests."""
+    scene = [node(1, "tv", (0, 0), (1.0, 0.3), (0.5, 1.2)), node(2, "dresser", (0, 1.0), (1.2, 0.5))]
+    task = decompose_instruction("take me to the tv in the bedroom", ReasoningConfig(), similarity=None)
+    assert infer_rooms(scene)[1][0] == "living_room"  # by its own cue
+    assert infer_rooms(scene, ignore=("tv",))[1][0] == "bedroom"
+    assert ground(scene[0], scene, task.relations, task.targets).status == "holds"
