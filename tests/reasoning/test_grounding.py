@@ -192,10 +192,10 @@ def test_a_node_observed_often_passes_the_offline_confidence_floor():
     the score is not (reasoning.offline.confident_observations)."""
     verifier = OfflineVerifier(ReasoningConfig())
     scene = _living_room_scene()
-    faint = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.35, n_obs=4,
+    faint = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.25, n_obs=4,
                  center=scene[0].center)
     assert verifier.verify(graph([faint, *scene[1:3]]), TASK).reason == "low_confidence"
-    often = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.35, n_obs=12,
+    often = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.25, n_obs=12,
                  center=scene[0].center)
     assert verifier.verify(graph([often, *scene[1:3]]), TASK).found
 
