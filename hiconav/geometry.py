@@ -161,6 +161,22 @@ def voxel_downsample(points: np.ndarray, voxel: float) -> np.ndarray:
     return out.astype(np.float32)
 
 
+def footprint_distance(box_min: np.ndarray, box_max: np.ndarray, xy: np.ndarray) -> float:
+    """Planar distance (m) from ``xy`` (2,) world to the footprint of the box ``box_min`` /
+    ``box_max`` (3,) world; 0 inside it."""
+    dx = max(box_min[0] - xy[0], 0.0, xy[0] - box_max[0])
+    dy = max(box_min[1] - xy[1], 0.0, xy[1] - box_max[1])
+    return math.hypot(dx, dy)
+
+
+def footprint_gap(a_min: np.ndarray, a_max: np.ndarray, b_min: np.ndarray, b_max: np.ndarray) -> float:
+    """Planar distance (m) between the footprints of two axis-aligned boxes (3,) world; 0 when
+    they overlap in plan."""
+    dx = max(b_min[0] - a_max[0], a_min[0] - b_max[0], 0.0)
+    dy = max(b_min[1] - a_max[1], a_min[1] - b_max[1], 0.0)
+    return math.hypot(dx, dy)
+
+
 def aabb(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Axis-aligned bounding box (min (3,), max (3,)) of (N, 3) points, N >= 1."""
     points = np.asarray(points)

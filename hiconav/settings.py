@@ -192,6 +192,13 @@ def effective_settings(overrides: dict[str, Any] | None = None) -> dict[str, Any
     return {area: model.model_dump(mode="json") for area, model in models.items()}
 
 
+def field_bounds(info: Any) -> tuple[float | None, float | None]:
+    """A pydantic field's inclusive range (``ge``, ``le``), None where it has none."""
+    lo = next((m.ge for m in info.metadata if getattr(m, "ge", None) is not None), None)
+    hi = next((m.le for m in info.metadata if getattr(m, "le", None) is not None), None)
+    return lo, hi
+
+
 def describe_settings(overrides: dict[str, Any] | None = None) -> list[str]:
     """One line per documented setting (a field with a description), every section:
     ``area.key = value  [min, max]  reason``; the value is the effective one."""
@@ -206,8 +213,7 @@ def describe_settings(overrides: dict[str, Any] | None = None) -> list[str]:
                 continue
             if not info.description:
                 continue
-            lo = next((m.ge for m in info.metadata if getattr(m, "ge", None) is not None), None)
-            hi = next((m.le for m in info.metadata if getattr(m, "le", None) is not None), None)
+            lo, hi = field_bounds(info)
             bounds = f"  [{'' if lo is None else lo}, {'' if hi is None else hi}]" if lo is not None or hi is not None \
                 else ""
             out.append(f"{prefix}.{key} = {value!r}{bounds}  {info.description}")

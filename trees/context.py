@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from hiconav.decisions.config import DecisionsConfig
+from hiconav.geometry import footprint_distance
 from hiconav.messages import GoalMsg, NavStatus, ParseRequest, StopRequest
 from hiconav.reasoning.grounding import target_relations
 from hiconav.types import Goal, Pose2D, TaskSpec
@@ -308,6 +309,4 @@ class MissionContext:
             if pose is None:
                 return math.inf
             xy = np.array([pose.x, pose.y])
-        dx = max(box_min[0] - xy[0], 0.0, xy[0] - box_max[0])
-        dy = max(box_min[1] - xy[1], 0.0, xy[1] - box_max[1])
-        return math.hypot(dx, dy)
+        return footprint_distance(box_min, box_max, xy)

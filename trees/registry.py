@@ -10,6 +10,7 @@ declarations. Users add behaviours with ``@register_behaviour`` or by import pat
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections.abc import Callable
@@ -101,15 +102,25 @@ class NodeSpec:
 BEHAVIOURS: Registry[NodeSpec] = Registry("behaviour")
 
 
+@functools.lru_cache(maxsize=None)
+def _settings_params(section: str) -> tuple[tuple[str, Param], ...]:
+    return tuple(_field_params(section).items())
+
+
 def settings_params(section: str | None) -> dict[str, Param]:
+    """One ``Param`` per field of the ``decisions.<section>`` settings (see ``_field_params``),
+    built once per section: a node's blackboard parameter is checked against it at tick time."""
+    return dict(_settings_params(section)) if section else {}
+
+
+def _field_params(section: str) -> dict[str, Param]:
     """One ``Param`` per field of the ``decisions.<section>`` settings (type, range, reason), with
     the ``FROM_SETTINGS`` default: a mission tree may override a field for one node, checked
     against the field's own declaration, and a node that does not reads the mission's settings."""
-    if not section:
-        return {}
     from typing import Literal, get_args, get_origin
 
     from hiconav.decisions.config import DecisionsConfig
+    from hiconav.settings import field_bounds
 
     model = DecisionsConfig.model_fields[section].annotation
     out: dict[str, Param] = {}
@@ -121,8 +132,7 @@ def settings_params(section: str | None) -> dict[str, Param]:
         elif get_origin(annotation) is list:
             items = (get_args(annotation) or (None,))[0]
             annotation = list
-        lo = next((m.ge for m in info.metadata if getattr(m, "ge", None) is not None), None)
-        hi = next((m.le for m in info.metadata if getattr(m, "le", None) is not None), None)
+        lo, hi = field_bounds(info)
         out[key] = Param(annotation, FROM_SETTINGS, minimum=lo, maximum=hi, choices=choices, items=items,
                          doc=f"{info.description} (default: decisions.{section}.{key})")
     return out

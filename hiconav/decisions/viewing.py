@@ -24,6 +24,7 @@ import numpy as np
 
 from hiconav.decisions.config import VerifySettings
 from hiconav.decisions.geometry import approach_cell
+from hiconav.geometry import footprint_distance
 
 #: the nearest view ring (m from the footprint): nearer, the robot's body overlaps the object's
 MIN_VIEW_RING = 0.3
@@ -36,11 +37,7 @@ DONE = ("reached", "failed")
 C = TypeVar("C")
 
 
-def box_distance(box_min: np.ndarray, box_max: np.ndarray, xy: np.ndarray) -> float:
-    """Planar distance (m) from ``xy`` (2,) world to the footprint of the box (3,) world."""
-    dx = max(box_min[0] - xy[0], 0.0, xy[0] - box_max[0])
-    dy = max(box_min[1] - xy[1], 0.0, xy[1] - box_max[1])
-    return math.hypot(dx, dy)
+box_distance = footprint_distance  # planar distance from a point to a box's footprint
 
 
 def view_ring(settings: VerifySettings, center_z: float, camera: tuple[float, float] | None) -> float:

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hiconav.geometry import footprint_gap
 from hiconav.memory.snapshot import AnchorView, MemorySnapshot, ObjectView
 from hiconav.types import TaskSpec
 
@@ -99,19 +100,11 @@ def _signature(kind: str, anchors: tuple[AnchorView, ...], objects: tuple[Object
     return (kind, tuple((a.id, a.object_ids) for a in anchors), tuple((o.id, o.label) for o in objects))
 
 
-def _gap(a: ObjectView, b: ObjectView) -> float:
-    """Planar gap (m) between two nodes' axis-aligned boxes (0 where they overlap)."""
-    lo_a, hi_a = np.asarray(a.box_min, dtype=np.float64)[:2], np.asarray(a.box_max, dtype=np.float64)[:2]
-    lo_b, hi_b = np.asarray(b.box_min, dtype=np.float64)[:2], np.asarray(b.box_max, dtype=np.float64)[:2]
-    d = np.maximum(np.maximum(lo_b - hi_a, lo_a - hi_b), 0.0)
-    return float(np.hypot(d[0], d[1]))
-
-
 def _context(snapshot: MemorySnapshot, focus: ObjectView, shown: tuple[ObjectView, ...],
              radius: float) -> tuple[ObjectView, ...]:
     """The snapshot's objects within ``radius`` of ``focus``'s box that ``shown`` lacks, by id."""
     have = {o.id for o in shown}
-    return tuple(o for o in snapshot.objects if o.id not in have and _gap(focus, o) <= radius)
+    return tuple(o for o in snapshot.objects if o.id not in have and footprint_gap(focus.box_min, focus.box_max, o.box_min, o.box_max) <= radius)
 
 
 def _described(task: TaskSpec) -> bool:

@@ -32,6 +32,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from hiconav.geometry import footprint_gap
 from hiconav.relations import NEAR, NEXT_TO
 
 # the same gaps as the ground-truth predicates that generate described-instance episodes
@@ -98,11 +99,8 @@ def room_of(label: str) -> str | None:
 # ------------------------------------------------------------------------------------ geometry
 def planar_gap(a: BoxLike, b: BoxLike) -> float:
     """Planar distance (m) between the footprints of two boxes; 0 when they overlap in plan."""
-    a0, a1 = np.asarray(a.box_min, float), np.asarray(a.box_max, float)
-    b0, b1 = np.asarray(b.box_min, float), np.asarray(b.box_max, float)
-    dx = max(b0[0] - a1[0], a0[0] - b1[0], 0.0)
-    dy = max(b0[1] - a1[1], a0[1] - b1[1], 0.0)
-    return math.hypot(dx, dy)
+    return footprint_gap(np.asarray(a.box_min, float), np.asarray(a.box_max, float),
+                         np.asarray(b.box_min, float), np.asarray(b.box_max, float))
 
 
 def _plan_overlap(a: BoxLike, b: BoxLike, pad: float = 0.05) -> bool:

@@ -17,28 +17,15 @@ from hiconav.trees.context import Candidate
 from hiconav.types import Goal
 
 
-def _stalled_toward(behaviour: MissionBehaviour, goal: np.ndarray | None, limit_s: float,
-                    near: float = 0.35, progress: float = 0.25) -> bool:
-    """True when, with a goal in flight (``behaviour._seq``), the robot has come no nearer to
-    ``goal`` (``StallClock``) for ``limit_s`` clock seconds; the clock is ``behaviour._stall``,
-    kept across activations until the behaviour resets it with a new goal."""
-    pose = behaviour.context.pose
-    if pose is None or goal is None or getattr(behaviour, "_seq", None) is None:
-        return False
-    clock = _stall_clock(behaviour)
-    return clock.stalled(math.hypot(pose.x - goal[0], pose.y - goal[1]), behaviour.context.now(), limit_s,
-                         near, progress)
-
-
-def _stall_clock(behaviour: MissionBehaviour) -> StallClock:
-    clock = getattr(behaviour, "_stall", None)
-    if clock is None:
-        clock = behaviour._stall = StallClock()  # type: ignore[attr-defined]
-    return clock
-
-
 class _GoToObject(MissionBehaviour):
-    """Shared machinery: choose a free cell near the candidate's footprint and go there facing it."""
+    """Shared machinery: choose a free cell near the candidate's footprint and go there facing it.
+
+    ``_stall`` (``StallClock``) lives as long as the behaviour: a new goal cell resets it, a new
+    activation does not."""
+
+    def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
+        super().__init__(*args, **kwargs)
+        self._stall = StallClock()
 
     READS = ("target",)
     def _centre_weight(self) -> float:
@@ -86,7 +73,7 @@ class _GoToObject(MissionBehaviour):
     def _go_to_cell(self, cand: Candidate, cell: np.ndarray, tolerance: float, through_unknown: bool = False) -> None:
         """Send the goal ``cell`` (world xy) facing the candidate, and restart the stall clock."""
         self._cell = cell
-        _stall_clock(self).reset()
+        self._stall.reset()
         self._seq = self.context.send_goal(Goal(float(cell[0]), float(cell[1]), _facing(cell, cand.center),
                                                 tolerance, "approach", cand.object_id,
                                                 through_unknown=through_unknown))
@@ -97,7 +84,11 @@ class _GoToObject(MissionBehaviour):
 
     def _stalled(self) -> bool:
         """True when the robot has made no progress toward the goal cell for ``stall_s``."""
-        return _stalled_toward(self, getattr(self, "_cell", None), self.param("stall_s"), self._stall_near())
+        pose, cell = self.context.pose, getattr(self, "_cell", None)
+        if pose is None or cell is None or getattr(self, "_seq", None) is None:
+            return False
+        return self._stall.stalled(math.hypot(pose.x - cell[0], pose.y - cell[1]), self.context.now(),
+                                   self.param("stall_s"), self._stall_near())
 
     def cleanup(self, new_status: Status) -> None:
         if getattr(self, "_seq", None) is not None and self.ctx is not None and new_status != Status.SUCCESS:
