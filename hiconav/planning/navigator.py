@@ -49,7 +49,7 @@ def squeeze_mask(grid: GridLike) -> np.ndarray:
     reaches 0.5-1.5 cells past the surface depending on where the grid's lines fall, and the
     lethal layer grows that by the robot radius less half a cell: in the scanned Gibson floors a
     passage the robot fits through (0.45 m, robot 0.36 m) lost its last free cell to that phase
-    error (Stockman/0/3: a toilet 1.04 m beyond the mission's end). One cell less leaves the
+    error, and a goal beyond it became unreachable. One cell less leaves the
     robot a few centimetres too close at worst; the simulator slides it along the wall, as a
     bumper-driven robot squeezes through a door."""
     lethal = lethal_mask(grid).astype(np.uint8)
@@ -208,9 +208,9 @@ class Navigator:
         res = grid.resolution
         if cfg.trail_free and self._trail:
             # where the robot centre has been it fits (the world is static to this map): a gap between
-            # furniture that the map's inflation closes behind the robot is no trap (Gibson
-            # Lakeville/0/3 rocked for 140 steps between two obstacles, its own cell lethal on the map,
-            # no way out on it); an obstacle seen there since still blocks
+            # furniture that the map's inflation closes behind the robot is no trap (a robot whose
+            # own cell is lethal on the map has no way out on it and rocks in place between two
+            # obstacles); an obstacle seen there since still blocks
             rows, cols = self._trail_cells(grid)
             blocked[rows, cols] &= grid.state[rows, cols] == 1
         for x, y, r in self._virtual:
@@ -248,8 +248,8 @@ class Navigator:
             return False
         found = self._search(grid, start, goal)
         if found is None and self._virtual:
-            # the virtual obstacles left by stuck steps may have walled the robot in (a corner of
-            # ProcTHOR val/52/1 held it for 400 steps): clear them, as a costmap-clearing recovery
+            # the virtual obstacles left by stuck steps may have walled the robot in (in a corner
+            # they can hold it until the step limit): clear them, as a costmap-clearing recovery
             # does, and plan once more on what the sensors saw
             log.info("navigator: no path with %d virtual obstacles; cleared them", len(self._virtual))
             self._virtual.clear()
@@ -272,8 +272,8 @@ class Navigator:
         A goal through unknown floor (the last short creep toward an object, a push into a
         frontier) plans on the tight mask alone: on the normal one a goal inside the inflation
         margin snaps back to the nearest roomy cell, which the robot had already reached, and the
-        creep ended 0.96 m from a plant it could have stood 0.85 m from (Gibson Ranchester/0/1,
-        success at 1 m). With ``squeeze_fallback``, such a goal that no path reaches on the tight
+        creep ends just outside a 1 m success region that the robot could have stood inside of.
+        With ``squeeze_fallback``, such a goal that no path reaches on the tight
         mask plans once more on ``squeeze_mask``."""
         modes = [(False, False), (True, False)] if self.config.tight_fallback else [(False, False)]
         if self.config.tight_fallback and self.goal is not None and self.goal.through_unknown:
@@ -343,9 +343,9 @@ class Navigator:
 
     def _settled(self, d: float) -> bool:
         """True once the robot, within ``settle_m`` of the goal (or the snapped path's end; ``d``),
-        has come no 2 cm nearer for ``settle_steps`` steps: a 0.25 m step carried ProcTHOR
-        val/45/2's robot back and forth across a path end it stood 0.12-0.13 m from, against a
-        0.125 m reach, for 460 steps (the behaviour above saw it within 0.35 m: glancing)."""
+        has come no 2 cm nearer for ``settle_steps`` steps: a discrete step longer than twice the
+        reach carries the robot back and forth across a path end it cannot land within the reach
+        of, for as long as the step limit allows (the behaviour above sees it within 0.35 m)."""
         cfg = self.config
         if self._settle is None or d < self._settle[0] - 0.02:
             self._settle = (d, 0)
@@ -359,8 +359,8 @@ class Navigator:
     def _open_side(self, grid: GridLike, pose: Pose2D) -> int:
         """+1 if the left (CCW) side is more open than the right, else -1 (ray casting to the
         occupied cells: a stuck robot often stands inside the inflation, where rays on the
-        inflated mask end at once on both sides and the tie turned it toward the nearer wall;
-        Gibson Lakeville/0/3 rocked so for 140 steps, 0.15 m from one obstacle, 0.3 m from the other)."""
+        inflated mask end at once on both sides and the tie turned it toward the nearer wall, so
+        that it rocked between two obstacles, nearer the one it turned to each time)."""
         blocked = np.asarray(grid.state) == 1
         rc = grid.world_to_cell(pose.xy) + 0.5
         angles = pose.yaw + np.array([math.pi / 2, math.pi / 3, -math.pi / 2, -math.pi / 3])
@@ -372,8 +372,8 @@ class Navigator:
         recoveries for this goal, this one included, began within ``give_up_m`` of it.
 
         A recovery turns away and steps; the robot that comes back to the same blocked step
-        recovers again, and only the mission's stall clock ended it: Gibson Lindenwood/0/0 turned
-        between two headings in one spot for 16 s of clock (two frontiers of 8 s each). Failing
+        recovers again, and only the mission's stall clock ended it: the robot turned between two
+        headings in one spot for the whole stall budget of every frontier it tried. Failing
         the goal hands the choice back to the mission, which tries the next frontier or cell."""
         cfg = self.config
         if cfg.max_recoveries <= 0:
@@ -464,17 +464,16 @@ class Navigator:
         point half a step ahead is a cell the map knows occupied.
 
         The planner keeps the robot centre a robot radius from every occupied cell, and the cells'
-        5 cm and their padding cost a few centimetres more; a creep toward an object ended 1.005 m
-        from a plant (success: 1 m) where the robot fitted 0.11 m nearer (Gibson Ranchester/0/1)."""
+        5 cm and their padding cost a few centimetres more, enough for a creep toward an object
+        to end just outside a 1 m success region where the robot fitted a decimetre nearer."""
         cfg = self.config
         goal = self.goal
         assert goal is not None
         step = cfg.discrete.forward_step_m
         d = float(np.hypot(*(goal.xy - pose.xy)))
         # blocked: a forward step that moved the robot little, or that brought it no nearer the
-        # goal: sliding along the object's side it moved 0.05-0.08 m per step, first one way then
-        # the other as its heading to the goal swung, for 3 s (Gibson Ranchester/0/3: 1.2 m driven
-        # 0.95 m from a plant without coming nearer)
+        # goal: sliding along an object's side it moves 0.05-0.08 m per step, first one way then
+        # the other as its heading to the goal swings, and drives on without coming nearer
         blocked = self._forward_blocked(pose) or (
             self._last_action == DiscreteAction.MOVE_FORWARD and self._straight_from is not None
             and self._straight_from - d < cfg.stuck_progress_m)

@@ -289,8 +289,8 @@ def box_footprint_cells(nav: NavGrid, obj: SimObject) -> np.ndarray:
     """(N, 2) int cells (row, col) whose centre lies in the object's footprint.
 
     Each side counts as at least one cell wide: a painting 3 cm thick and 94 cm long lies between
-    two columns of cell centres, and its footprint was the one cell at its middle, so a robot
-    0.57 m from the painting's end stood 1.02 m from its "footprint" and failed (val/65/2).
+    two columns of cell centres, and its footprint would be the one cell at its middle, so a robot
+    half a metre from the painting's end would stand over a metre from its "footprint".
     Objects smaller than a cell both ways still get the cell that contains their centre.
     """
     size = np.maximum(np.asarray(obj.size[:2], dtype=np.float64), nav.resolution * (1.0 + 1e-6))

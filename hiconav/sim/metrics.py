@@ -6,8 +6,8 @@ length and l the shortest path that succeeds: the geodesic distance from the sta
 success region (the cells within ``success_distance`` of the goal), as Habitat's ObjectNav
 measures it to the goal's view points (Anderson et al. 2018; Batra et al. 2020). Measured to
 the goal object itself, l exceeds the shortest successful path by up to the success distance:
-an agent that stopped on the region's edge after 0.97 m scored SPL 1 against an "l" of 1.57 m
-(Gibson Stockman/0/1), and SPL over-stated efficiency most on the shortest episodes. DTS: the
+an agent that stops on the region's edge scores SPL 1 with a path shorter than "l", and SPL
+over-states efficiency most on the shortest episodes. DTS: the
 geodesic distance to the success region at the end. Distances to the region are any-angle
 (fast marching, ``geodesic``). This module
 scores episodes; it must not move the robot.
