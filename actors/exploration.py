@@ -17,7 +17,7 @@ import numpy as np
 from hiconav.actors.node import Node
 from hiconav.actors.runtime import NodeActor
 
-from hiconav.messages import PlanMsg, TaskMsg, WorldSnapshot
+from hiconav.messages import PlanMsg, RuledOut, TaskMsg, WorldSnapshot
 from hiconav.types import Frontier
 
 
@@ -52,7 +52,13 @@ class ExplorationNode(Node):
         self._last_stamp = None
         self.plans = 0
         self.latest_wins(WorldSnapshot)
-        self.on(TaskMsg, lambda m, now: setattr(self, "task", m.task))
+        self.ruled_out: frozenset[int] = frozenset()  # target-category nodes the reasoning ruled out
+        self.on(TaskMsg, self._on_task)
+        self.on(RuledOut, lambda m, now: setattr(self, "ruled_out", frozenset(m.object_ids)))
+
+    def _on_task(self, msg: TaskMsg, now: float) -> None:
+        self.task = msg.task
+        self.ruled_out = frozenset()
 
     def tick(self, now: float) -> None:
         snap = self.take(WorldSnapshot)
@@ -67,7 +73,7 @@ class ExplorationNode(Node):
         self._last_pose, self._last_stamp = pose, now
         if self.planner is not None and self.task is not None:
             plan = self.planner.plan(snap.grid, frontiers, snap.memory, self.task, pose, velocity,
-                                     self.similarity, now)
+                                     self.similarity, now, ruled_out=self.ruled_out)
         else:
             order = sorted(frontiers, key=lambda f: (math.hypot(f.viewpoint[0] - pose.x, f.viewpoint[1] - pose.y), f.id))
             plan = NearestPlan(order[0] if order else None, tuple(f.id for f in order))

@@ -22,7 +22,7 @@ from typing import Any
 from hiconav.actors.node import Node
 from hiconav.actors.runtime import NodeActor
 
-from hiconav.messages import HypothesisMsg, ParseRequest, ReasoningBusy, TargetRejected, TaskMsg, WorldSnapshot
+from hiconav.messages import HypothesisMsg, ParseRequest, ReasoningBusy, RuledOut, TargetRejected, TaskMsg, WorldSnapshot
 
 
 class ReasoningActor(NodeActor):
@@ -59,6 +59,9 @@ class ReasoningNode(Node):
         # decomposition of the last memory snapshot, reused while the graph's views are unchanged
         self._decomposed: tuple[Any, Any, list] | None = None
         self.decompose_reused = 0
+        # object id -> the last verdict on a described instance's relations (``VerifyResult.verdicts``)
+        self.verdicts: dict[int, str] = {}
+        self._ruled_out: frozenset[int] = frozenset()
         self.latest_wins(WorldSnapshot)
         self.on(ParseRequest, lambda m, now: setattr(self, "_parse", m))
         self.on(TaskMsg, self._on_task)
@@ -69,6 +72,7 @@ class ReasoningNode(Node):
 
     def _set_task(self, task: Any) -> None:
         self.task = task
+        self.verdicts.clear()
         self.reasoner = self.make_reasoner(task) if self.make_reasoner is not None else None
 
     def _on_rejected(self, msg: TargetRejected, now: float) -> None:
@@ -100,6 +104,15 @@ class ReasoningNode(Node):
         self._decomposed = (memory, self.task, list(subgraphs))
         return subgraphs
 
+    def _post_ruled_out(self, result: Any, now: float, delay: float) -> None:
+        """Tell exploration which target-category nodes the relations rule out, when that set
+        changes (a later verdict that holds or is unknown takes a node back)."""
+        self.verdicts.update(getattr(result, "verdicts", None) or {})
+        ruled_out = frozenset(i for i, v in self.verdicts.items() if v == "fails")
+        if ruled_out != self._ruled_out:
+            self._ruled_out = ruled_out
+            self.emit("exploration", RuledOut(ruled_out, now + delay), delay)
+
     def tick(self, now: float) -> None:
         if now < self.busy_until - 1e-9:
             return  # the previous reply is not visible yet (stepped time)
@@ -128,6 +141,7 @@ class ReasoningNode(Node):
         self.requests += 1
         delay = self._delay(self.latency_s, float(result.latency_s))
         self._busy(now, delay)
+        self._post_ruled_out(result, now, delay)
         self.events.append({"t": now, "kind": "verify", "subgraph": getattr(subgraph, "kind", ""),
                             "found": bool(result.found), "reason": result.reason, "latency_s": delay,
                             "source": result.source, "detail": result.detail[:400]})

@@ -90,6 +90,16 @@ class PlanMsg:
 
 
 @dataclass(frozen=True)
+class RuledOut:
+    """Reasoning -> Exploration: the object nodes of the target's category that the reasoning
+    layer judged not to be the described instance (a relation of the instruction fails on them),
+    the whole current set (latest wins); exploration stops treating them as target evidence."""
+
+    object_ids: frozenset[int]
+    stamp: float = 0.0
+
+
+@dataclass(frozen=True)
 class HypothesisMsg:
     """Reasoning -> Mission, Memory: a ``TargetHypothesis`` (None: the subgraph held no target).
 

@@ -20,7 +20,7 @@ not navigate, read sensors or own the grid/memory (it receives read-only snapsho
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -119,14 +119,18 @@ class ExplorationPlanner:
 
     def plan(self, grid: GridLike, frontiers: Sequence[Frontier], snapshot: SnapshotLike | None,
              task: TaskSpec, pose: Pose2D, velocity_xy: np.ndarray | Sequence[float],
-             similarity: Callable[[str, str], float] | None, now: float = 0.0) -> ExplorationPlan:
+             similarity: Callable[[str, str], float] | None, now: float = 0.0,
+             ruled_out: Collection[int] = ()) -> ExplorationPlan:
         """Order the frontiers and pick the mid-term goal.
 
         grid: the current occupancy grid (snapshot); frontiers: from the FrontierTracker (stable
         ids); snapshot: memory objects/anchors (None = none); pose: robot base pose (world);
         velocity_xy: (2,) robot velocity in the world frame (m/s); similarity(label, target) in
         [0, 1]-ish (an Embedder's similarity; None = FALLBACK exact label match only: 1 for a
-        target label, 0 otherwise); now: stamp copied into the plan.
+        target label, 0 otherwise); now: stamp copied into the plan; ruled_out: ids of memory
+        objects that are no evidence of the target (instances of its category that the reasoning
+        layer judged not to be the described one): S_struct leaves them out, or the robot would
+        be drawn back, frontier after frontier, to the wrong instances it has already seen.
         """
         if similarity is None:
             similarity = _exact_label_match
@@ -135,6 +139,9 @@ class ExplorationPlanner:
         previous = self.goal_id
         frontiers = list(frontiers)
         objects = tuple(getattr(snapshot, "objects", ())) if snapshot is not None else ()
+        if ruled_out:
+            skip = set(ruled_out)
+            objects = tuple(o for o in objects if getattr(o, "id", None) not in skip)
         anchors = tuple(getattr(snapshot, "anchors", ())) if snapshot is not None else ()
         ids = [f.id for f in frontiers]
         if not frontiers:

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -96,6 +96,9 @@ class VerifyResult:
     latency_s: float
     source: str
     subgraph_signature: tuple
+    # object id -> "holds" | "fails" | "unknown": the grounding of a described instance's
+    # relations on each candidate node the verifier judged (empty when it judged none)
+    verdicts: Mapping[int, str] = field(default_factory=dict)
 
     @property
     def rejected(self) -> bool:
@@ -277,9 +280,10 @@ class OfflineVerifier:
             reason = next((r for r in (RELATION_UNKNOWN, RELATION_FAILED, FEW_OBSERVATIONS, LOW_CONFIDENCE)
                            if r in reasons), NO_MATCH)
             detail = "; ".join(f"#{oid}: {' | '.join(g.evidence)}" for oid, g in groundings.items())
-            return _not_found(subgraph, self.source, reason,
-                              f"no object node supports {'/'.join(task.targets)} ({reason})"
-                              + (f": {detail}" if detail else ""), latency)
+            verdicts = {oid: g.status for oid, g in groundings.items()}
+            return replace(_not_found(subgraph, self.source, reason,
+                                      f"no object node supports {'/'.join(task.targets)} ({reason})"
+                                      + (f": {detail}" if detail else ""), latency), verdicts=verdicts)
         _, obj, score, target, (anchor, bbox) = best
         attrs = [a for t in task.targets for a in task.attributes.get(t, ())]
         evidence = (f"offline: object node {obj.id} labelled {obj.label!r} (similarity {score:.2f} to "
@@ -292,7 +296,8 @@ class OfflineVerifier:
                                confidence=float(score * obj.confidence), evidence=evidence,
                                latency_s=latency, source=self.source,
                                subgraph_signature=tuple(subgraph.signature), label=target)
-        return VerifyResult(True, hyp, FOUND, evidence, latency, self.source, tuple(subgraph.signature))
+        return VerifyResult(True, hyp, FOUND, evidence, latency, self.source, tuple(subgraph.signature),
+                            {oid: g.status for oid, g in groundings.items()})
 
     @staticmethod
     def _best_view(obj: ObjectLike, anchors: Sequence[AnchorLike]) -> tuple[AnchorLike, np.ndarray] | None:

@@ -64,3 +64,30 @@ def test_a_replaced_view_of_the_same_object_is_a_change():
     _tick(node, SimpleNamespace(objects=(object(),), anchors=(), stamp=0.1), 0.1)
     _tick(node, SimpleNamespace(objects=(object(),), anchors=(), stamp=0.2), 0.2)  # rebuilt view
     assert len(calls) == 2 and node.decompose_reused == 0
+
+
+def test_relations_that_fail_rule_instances_out_for_exploration_until_judged_again():
+    from hiconav.messages import RuledOut
+
+    class _Queue(_Reasoner):
+        def next(self):
+            return SimpleNamespace(kind="target", signature=(1,))
+
+        def accept(self, result):
+            pass
+
+    replies = iter([{4: "fails", 5: "unknown"}, {4: "fails", 5: "fails"}, {4: "holds"}])
+
+    class _Verifier:
+        def verify(self, subgraph, task):
+            return SimpleNamespace(found=False, hypothesis=None, reason="relation_failed", detail="",
+                                   latency_s=0.0, source="offline", verdicts=next(replies))
+
+    node = ReasoningNode(parse=lambda text: text, make_reasoner=lambda task: _Queue(), verifier=_Verifier(),
+                         decompose=lambda memory, task, similarity, k=5: [], latency_s=0.0)
+    node._set_task("find the bed by the lamp")
+    posted = []
+    for t in (0.1, 0.2, 0.3):
+        _tick(node, SimpleNamespace(objects=(), anchors=(), stamp=t), t)
+        posted += [o.msg.object_ids for o in node.drain() if isinstance(o.msg, RuledOut) and o.dest == "exploration"]
+    assert posted == [frozenset({4}), frozenset({4, 5}), frozenset({5})]

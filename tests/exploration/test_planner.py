@@ -166,3 +166,18 @@ def test_a_deterministic_planner_runs_the_ils_without_a_wall_time_limit(monkeypa
     assert calls[0]["time_limit"] is None and calls[0]["max_restarts"] == cfg.ordering.stepped_restarts
     plan(ExplorationPlanner(cfg), 5.5, frontiers)
     assert calls[-1]["time_limit"] == cfg.ordering.time_limit
+
+
+def test_ruled_out_instances_are_no_target_evidence() -> None:
+    """A bed the reasoning ruled out (not the described one) no longer draws the robot back."""
+    from types import SimpleNamespace
+
+    o = make_object("bed", (1.0, 5.0), (1.0, 1.0, 0.6))
+    bed = SimpleNamespace(id=3, label=o.label, center=o.center, box_min=o.box_min, box_max=o.box_max)
+    cfg = ExplorationConfig(cost=CostConfig(stride=1), utility=UtilityConfig(beta=5.0))
+    snap = Snapshot(objects=(bed,))
+    drawn = plan(ExplorationPlanner(cfg), 5.5, snapshot=snap)
+    assert drawn.goal.id == B.id and drawn.s_struct[B.id] > 0.3
+    free = ExplorationPlanner(cfg).plan(room(), [A, B], snap, TASK, Pose2D(5.5, 5.0, 0.0), np.zeros(2),
+                                        similarity, now=1.0, ruled_out=frozenset({3}))
+    assert free.goal.id == A.id and free.s_struct[B.id] == 0.0

@@ -159,12 +159,14 @@ def test_the_offline_verifier_confirms_only_the_described_instance():
     only_the_other = graph([o for o in _living_room_scene() if o.id in (4, 5)])
     missed = verifier.verify(only_the_other, TASK)
     assert not missed.found and "relation" in missed.reason
+    # the verdict on every candidate judged travels with the result (exploration drops the failed)
+    assert result.verdicts == {1: "holds", 4: "fails"} and missed.verdicts == {4: "fails"}
 
 
 def test_the_offline_verifier_waits_for_the_related_object():
     verifier = OfflineVerifier(ReasoningConfig())
     result = verifier.verify(graph([node(1, "armchair", (0, 0)), node(3, "sofa", (0, 2.0), (2.0, 0.9))]), TASK)
-    assert not result.found and result.reason == RELATION_UNKNOWN
+    assert not result.found and result.reason == RELATION_UNKNOWN and result.verdicts == {1: "unknown"}
 
 
 @dataclass(frozen=True)
