@@ -87,6 +87,8 @@ class ReasoningConfig(BaseModel):
     default_vlm_confidence: float = Field(0.7, ge=0, le=1)  # when the reply gives none
     max_latency_s: float | None = Field(None, gt=0, le=MAX_DURATION_S)  # replies slower than this are "late"
     max_attempts_per_subgraph: int = Field(2, ge=1)  # transient failures (timeouts, 5xx) retried
+    # a target subgraph around an object never judged goes before re-checks of judged ones
+    fresh_targets_first: bool = True
     fallback_to_offline: bool = True  # decomposition falls back (labelled) when the VLM fails
     max_related: int = Field(6, ge=0)
     label_similarity_threshold: float = Field(0.62, ge=0, le=1)  # noun -> vocabulary by embedding

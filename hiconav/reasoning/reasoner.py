@@ -76,6 +76,7 @@ class Reasoner:
         self._attempts: collections.Counter = collections.Counter()  # transient failures per signature
         self._in_flight: dict[tuple, Any] = {}
         self._retracted: set[tuple] = set()
+        self._judged: set[Any] = set()  # focus objects of the subgraphs answered
         self.candidates: list[TargetHypothesis] = []  # found, below the confirmation threshold
         self.confirmed: TargetHypothesis | None = None
 
@@ -116,10 +117,23 @@ class Reasoner:
     def next(self) -> Any | None:
         """The highest-priority subgraph not yet checked (marked in flight), or None.
 
+        With ``fresh_targets_first``, a target subgraph around an object never judged comes
+        before every subgraph whose focus was judged already: a target node seen for the first
+        time is new evidence, where a judged node's subgraph changed by one more view mostly
+        repeats its verdict, and in a house with many instances of the category the re-checks
+        would keep the new one waiting for minutes.
+
         Returns None once a hypothesis is confirmed or when nothing new is left.
         """
         if self.done:
             return None
+        if self.config.fresh_targets_first:
+            for sg in self._queue:
+                focus = getattr(sg, "focus_object_id", None)
+                if (getattr(sg, "kind", "") == "target" and focus is not None and focus not in self._judged
+                        and self._eligible(tuple(sg.signature))):
+                    self._in_flight[tuple(sg.signature)] = sg
+                    return sg
         skipped = 0
         for sg in self._queue:
             sig = tuple(sg.signature)
@@ -141,7 +155,7 @@ class Reasoner:
             self.stats.stale_results += 1
             log.info("reasoner: ignoring a result for a subgraph not in flight (stale)")
             return None
-        del self._in_flight[sig]
+        sg = self._in_flight.pop(sig)
         self.stats.calls += 1
         self.stats.latencies_s.append(float(result.latency_s))
         if self.done:
@@ -149,6 +163,7 @@ class Reasoner:
             return None
         if result.found and result.hypothesis is not None and result.reason == FOUND:
             self._checked.add(sig)
+            self._judged.add(getattr(sg, "focus_object_id", None))
             self.stats.found += 1
             hyp = result.hypothesis
             if hyp.confidence >= self.config.confirm_confidence:
@@ -170,6 +185,7 @@ class Reasoner:
                 self.stats.retries += 1
                 return None
         self._checked.add(sig)
+        self._judged.add(getattr(sg, "focus_object_id", None))
         return None
 
     def step(self, verifier: Any) -> VerifyResult | None:

@@ -197,3 +197,32 @@ def test_the_config_selects_the_verifier(server) -> None:
     assert isinstance(make_verifier(fast_config(server.base_url).model_copy(update={"backend": "offline"})),
                       OfflineVerifier)
     assert VERIFIERS.names() == ["offline", "vlm"]
+
+
+def test_a_target_seen_for_the_first_time_goes_before_re_checks_of_judged_ones() -> None:
+    def around(focus: int, version: int):
+        return _Focused(sg(f"t{focus}", version), focus)
+
+    verifier = ScriptedVerifier({})
+    reasoner = Reasoner(make_task())
+    reasoner.update([around(1, 0), around(2, 0)])
+    reasoner.step(verifier), reasoner.step(verifier)
+    # both changed by one more view, and a third instance appears last in the queue
+    reasoner.update([around(1, 1), around(2, 1), around(3, 0)])
+    reasoner.step(verifier)
+    assert verifier.asked[-1] == ("t3", 0)
+    reasoner.step(verifier)
+    assert verifier.asked[-1] == ("t1", 1)  # then the queue's own order
+    plain = Reasoner(make_task(), ReasoningConfig(fresh_targets_first=False))
+    plain.update([around(1, 0)])
+    plain.step(verifier)
+    plain.update([around(1, 1), around(3, 0)])
+    assert plain.next().signature == ("t1", 1)
+
+
+class _Focused:
+    """A subgraph with a focus object (FakeSubgraph has none)."""
+
+    def __init__(self, inner, focus: int) -> None:
+        self.__dict__.update(vars(inner))
+        self.focus_object_id = focus
