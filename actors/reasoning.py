@@ -73,6 +73,7 @@ class ReasoningNode(Node):
     def _set_task(self, task: Any) -> None:
         self.task = task
         self.verdicts.clear()
+        self._ruled_out = frozenset()  # exploration forgets its set on the new TaskMsg too
         self.reasoner = self.make_reasoner(task) if self.make_reasoner is not None else None
 
     def _on_rejected(self, msg: TargetRejected, now: float) -> None:

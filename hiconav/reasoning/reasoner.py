@@ -155,7 +155,7 @@ class Reasoner:
             self.stats.stale_results += 1
             log.info("reasoner: ignoring a result for a subgraph not in flight (stale)")
             return None
-        sg = self._in_flight.pop(sig)
+        focus = getattr(self._in_flight.pop(sig), "focus_object_id", None)
         self.stats.calls += 1
         self.stats.latencies_s.append(float(result.latency_s))
         if self.done:
@@ -163,7 +163,7 @@ class Reasoner:
             return None
         if result.found and result.hypothesis is not None and result.reason == FOUND:
             self._checked.add(sig)
-            self._judged.add(getattr(sg, "focus_object_id", None))
+            self._judge(focus)
             self.stats.found += 1
             hyp = result.hypothesis
             if hyp.confidence >= self.config.confirm_confidence:
@@ -185,8 +185,12 @@ class Reasoner:
                 self.stats.retries += 1
                 return None
         self._checked.add(sig)
-        self._judged.add(getattr(sg, "focus_object_id", None))
+        self._judge(focus)
         return None
+
+    def _judge(self, focus: Any) -> None:
+        if focus is not None:  # "remaining" subgraphs have no focus object
+            self._judged.add(focus)
 
     def step(self, verifier: Any) -> VerifyResult | None:
         """Synchronous convenience (stepped clock, tests): next(), verify, accept()."""

@@ -276,11 +276,11 @@ class OfflineVerifier:
             if best is None or key > best[0]:
                 best = (key, obj, score, target, view)
         latency = time.perf_counter() - t0
+        verdicts = {oid: g.status for oid, g in groundings.items()}
         if best is None:
             reason = next((r for r in (RELATION_UNKNOWN, RELATION_FAILED, FEW_OBSERVATIONS, LOW_CONFIDENCE)
                            if r in reasons), NO_MATCH)
             detail = "; ".join(f"#{oid}: {' | '.join(g.evidence)}" for oid, g in groundings.items())
-            verdicts = {oid: g.status for oid, g in groundings.items()}
             return replace(_not_found(subgraph, self.source, reason,
                                       f"no object node supports {'/'.join(task.targets)} ({reason})"
                                       + (f": {detail}" if detail else ""), latency), verdicts=verdicts)
@@ -297,7 +297,7 @@ class OfflineVerifier:
                                latency_s=latency, source=self.source,
                                subgraph_signature=tuple(subgraph.signature), label=target)
         return VerifyResult(True, hyp, FOUND, evidence, latency, self.source, tuple(subgraph.signature),
-                            {oid: g.status for oid, g in groundings.items()})
+                            verdicts)
 
     @staticmethod
     def _best_view(obj: ObjectLike, anchors: Sequence[AnchorLike]) -> tuple[AnchorLike, np.ndarray] | None:

@@ -76,7 +76,7 @@ def test_relations_that_fail_rule_instances_out_for_exploration_until_judged_aga
         def accept(self, result):
             pass
 
-    replies = iter([{4: "fails", 5: "unknown"}, {4: "fails", 5: "fails"}, {4: "holds"}])
+    replies = iter([{4: "fails", 5: "unknown"}, {4: "fails", 5: "fails"}, {4: "holds"}, {5: "fails"}])
 
     class _Verifier:
         def verify(self, subgraph, task):
@@ -91,3 +91,7 @@ def test_relations_that_fail_rule_instances_out_for_exploration_until_judged_aga
         _tick(node, SimpleNamespace(objects=(), anchors=(), stamp=t), t)
         posted += [o.msg.object_ids for o in node.drain() if isinstance(o.msg, RuledOut) and o.dest == "exploration"]
     assert posted == [frozenset({4}), frozenset({4, 5}), frozenset({5})]
+    # a new task: exploration forgets its set, so the same set is sent again
+    node._set_task("find the bed by the sofa")
+    _tick(node, SimpleNamespace(objects=(), anchors=(), stamp=0.4), 0.4)
+    assert [o.msg.object_ids for o in node.drain() if isinstance(o.msg, RuledOut)] == [frozenset({5})]
