@@ -21,6 +21,7 @@ from hiconav.trees.mission_tree import MissionTree
 
 from hiconav.messages import (
     EpisodeEnded,
+    ExploredOut,
     GoalMsg,
     HealthAlert,
     HypothesisMsg,
@@ -35,7 +36,8 @@ from hiconav.messages import (
     WorldSnapshot,
 )
 
-_ROUTES = {ParseRequest: "reasoning", GoalMsg: "control", StopRequest: "control", TargetRejected: "reasoning"}
+_ROUTES = {ParseRequest: "reasoning", GoalMsg: "control", StopRequest: "control", TargetRejected: "reasoning",
+           ExploredOut: "reasoning"}
 
 
 class MissionActor(NodeActor):

@@ -22,7 +22,9 @@ from typing import Any
 from hiconav.actors.node import Node
 from hiconav.actors.runtime import NodeActor
 
-from hiconav.messages import HypothesisMsg, ParseRequest, ReasoningBusy, RuledOut, TargetRejected, TaskMsg, WorldSnapshot
+from hiconav.messages import (ExploredOut, HypothesisMsg, ParseRequest, ReasoningBusy, RuledOut, TargetRejected,
+                              TaskMsg, WorldSnapshot)
+from hiconav.reasoning.unresolved import unresolved_hypothesis
 
 
 class ReasoningActor(NodeActor):
@@ -62,10 +64,15 @@ class ReasoningNode(Node):
         # object id -> the last verdict on a described instance's relations (``VerifyResult.verdicts``)
         self.verdicts: dict[int, str] = {}
         self._ruled_out: frozenset[int] = frozenset()
+        # the search explored out: offer the best unresolved candidate (once per ExploredOut)
+        self._explored_out = False
+        self._offered: set[int] = set()
+        self._memory: Any = None  # the last memory snapshot seen
         self.latest_wins(WorldSnapshot)
         self.on(ParseRequest, lambda m, now: setattr(self, "_parse", m))
         self.on(TaskMsg, self._on_task)
         self.on(TargetRejected, self._on_rejected)
+        self.on(ExploredOut, lambda m, now: setattr(self, "_explored_out", True))
 
     def _on_task(self, msg: TaskMsg, now: float) -> None:
         self._set_task(msg.task)
@@ -74,6 +81,8 @@ class ReasoningNode(Node):
         self.task = task
         self.verdicts.clear()
         self._ruled_out = frozenset()  # exploration forgets its set on the new TaskMsg too
+        self._explored_out = False
+        self._offered = set()
         self.reasoner = self.make_reasoner(task) if self.make_reasoner is not None else None
 
     def _on_rejected(self, msg: TargetRejected, now: float) -> None:
@@ -129,6 +138,12 @@ class ReasoningNode(Node):
             self.emit(self.task_to, TaskMsg(task, now + delay), delay)
             return
         snap = self.take(WorldSnapshot)
+        if snap is not None and snap.memory is not None:
+            self._memory = snap.memory
+        if self._explored_out:
+            self._explored_out = False
+            if self._offer_unresolved(now):
+                return
         if (snap is None or self.reasoner is None or self.verifier is None or self.decompose is None
                 or snap.memory is None or self.reasoner.done):
             return
@@ -149,6 +164,27 @@ class ReasoningNode(Node):
         if result.found and result.hypothesis is not None:
             self.emit(("mission", "memory", "recorder"), HypothesisMsg(result.hypothesis, now + delay, now, "", result.detail,
                                                            str(getattr(subgraph, "kind", ""))), delay)
+
+
+    def _offer_unresolved(self, now: float) -> bool:
+        """The search explored out: send the best unresolved candidate of a described instance
+        (``hiconav.reasoning.unresolved``) as a hypothesis, one not offered before; a reasoning
+        call like any other (it takes the modelled latency). True when one was sent."""
+        if self.task is None or self._memory is None or (self.reasoner is not None and self.reasoner.done):
+            return False
+        hyp = unresolved_hypothesis(self._memory, self.verdicts, self.task.targets, exclude=self._offered)
+        if hyp is None:
+            self.events.append({"t": now, "kind": "unresolved", "found": False, "reason": "none left"})
+            return False
+        self._offered.add(int(hyp.object_id))
+        self.requests += 1
+        delay = self._delay(self.latency_s, 0.0)
+        self._busy(now, delay)
+        self.events.append({"t": now, "kind": "unresolved", "found": True, "reason": "explored out",
+                            "latency_s": delay, "source": hyp.source, "detail": hyp.evidence[:400]})
+        self.emit(("mission", "memory", "recorder"),
+                  HypothesisMsg(hyp, now + delay, now, "", hyp.evidence, "unresolved"), delay)
+        return True
 
 
 def _same_views(a: Any, b: Any) -> bool:

@@ -100,6 +100,15 @@ class RuledOut:
 
 
 @dataclass(frozen=True)
+class ExploredOut:
+    """Mission -> Reasoning: the search has no frontier left and no confirmed target; the
+    reasoning layer answers with a ``HypothesisMsg`` of its best unresolved candidate of a
+    described instance (``hiconav.reasoning.unresolved``), or with nothing when none is left."""
+
+    stamp: float = 0.0
+
+
+@dataclass(frozen=True)
 class HypothesisMsg:
     """Reasoning -> Mission, Memory: a ``TargetHypothesis`` (None: the subgraph held no target).
 

@@ -475,7 +475,8 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
         detector=result.detector, reasoner=result.reasoner, error=result.failure,
         error_kind="runtime" if result.failure else None,
         extra={"mission": result.mission_status, "fallbacks": result.fallbacks,
-               "reasoning_calls": int(sum(1 for e in result.reasoning_events if e["kind"] == "verify")),
+               "reasoning_calls": int(sum(1 for e in result.reasoning_events
+                                          if e["kind"] == "verify" or (e["kind"] == "unresolved" and e["found"]))),
                "feedback": result.mission_feedback,
                "shortest_to_success": float(m.shortest_to_success),  # SPL's l (docs/evaluation.md)
                "dropped": {k: dict(v.dropped) for k, v in result.stats.items() if v.dropped}})

@@ -22,7 +22,7 @@ import numpy as np
 
 from hiconav.decisions.config import DecisionsConfig
 from hiconav.geometry import footprint_distance
-from hiconav.messages import GoalMsg, NavStatus, ParseRequest, StopRequest
+from hiconav.messages import ExploredOut, GoalMsg, NavStatus, ParseRequest, StopRequest
 from hiconav.reasoning.grounding import target_relations
 from hiconav.types import Goal, Pose2D, TaskSpec
 
@@ -110,6 +110,8 @@ class MissionContext:
     failed_frontiers: set[int] = field(default_factory=set)
     # centroids of failed frontiers Explore tried once more on the squeeze mask (``squeeze``)
     squeezed_frontiers: list[tuple[float, float]] = field(default_factory=list)
+    # times an explored-out search asked the reasoning layer for its best unresolved candidate
+    unresolved_asks: int = 0
     # quarter turns in place done at the mission's start (Explore's start_look_turns); shared by
     # every Explore instance, so the look-around happens once per mission
     start_looks: int = 0
@@ -137,6 +139,11 @@ class MissionContext:
     # -- requests (turned into messages by the Mission actor after the tick) ---------------------
     def request_task(self, instruction: str) -> None:
         self.outbox.append(ParseRequest(instruction, self.now()))
+
+    def report_explored_out(self) -> None:
+        """Tell the reasoning layer that the search has no frontier left (``ExploredOut``)."""
+        self.unresolved_asks += 1
+        self.outbox.append(ExploredOut(self.now()))
 
     def send_goal(self, goal: Goal | None) -> int:
         """Ask the control layer to go to ``goal`` (None cancels); returns the request's seq."""

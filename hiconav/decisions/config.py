@@ -71,6 +71,8 @@ class ExploreSettings(_Section):
                            0.01, 5.0)
     squeeze: bool = _f(True, "with every frontier failed, try each once more through unknown floor on the "
                              "navigator's thinner masks before giving up")
+    unresolved_asks: int = _f(3, "explored out in search of a described instance, ask the reasoning layer this "
+                                 "many times for its best unresolved candidate before failing", 0, 100)
 
 
 class VerifySettings(_Section):

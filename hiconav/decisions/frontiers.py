@@ -79,7 +79,9 @@ class ExploreLedger:
     lists are the mission's own and are appended to in place: ``spent_viewpoints``, reached
     viewpoints that did not clear their frontier; ``pushed_frontiers`` and
     ``squeezed_frontiers``, centroids pushed or squeezed into (world xy m); ``failed_frontiers``,
-    ids of frontiers whose goal failed.
+    ids of frontiers whose goal failed; ``unresolved_asks_left``: how many more times an
+    explored-out search may ask the reasoning layer for its best unresolved candidate (0: never,
+    as for a task without a described instance).
     """
 
     last_frontier_time: float
@@ -90,6 +92,7 @@ class ExploreLedger:
     pushed_frontiers: list[Spot] = field(default_factory=list)
     failed_frontiers: set[int] = field(default_factory=set)
     squeezed_frontiers: list[Spot] = field(default_factory=list)
+    unresolved_asks_left: int = 0
 
 
 @dataclass(frozen=True)
@@ -114,8 +117,9 @@ class FrontierGoal:
 @dataclass(frozen=True)
 class ExploreStep:
     """One tick's decision: the status, a feedback line, the goal to send (None: none), whether
-    to cancel the goal in flight first, the lines to log in order, and whether the deferred
-    candidates are due now (explored out: they are all that is left)."""
+    to cancel the goal in flight first, the lines to log in order, whether the deferred
+    candidates are due now (explored out: they are all that is left), and whether to ask the
+    reasoning layer for its best unresolved candidate (explored out, nothing deferred)."""
 
     status: Literal["running", "failure"]
     feedback: str
@@ -123,6 +127,7 @@ class ExploreStep:
     cancel: bool = False
     log: tuple[str, ...] = ()
     release_deferred: bool = False
+    ask_unresolved: bool = False
     ended: bool = False  # the goal in flight ended (reached, failed or given up): forget it
 
 
@@ -397,6 +402,15 @@ class FrontierFollower:
                 ledger.last_frontier_time = now
                 return ExploreStep("running", "no frontier left: back to the deferred candidates", cancel=cancel,
                                    log=tuple(log), release_deferred=True)
+            if ledger.unresolved_asks_left > 0:
+                # explored out in search of a described instance: the instances seen whose
+                # relations could not be confirmed are all that is left, and the reasoning layer
+                # ranks them (``hiconav.reasoning.unresolved``); wait one more idle period for it
+                ledger.unresolved_asks_left -= 1
+                ledger.last_frontier_time = now
+                log.append("no frontier left: asking the reasoning layer for its best unresolved candidate")
+                return ExploreStep("running", "no frontier left: asking for the best unresolved candidate",
+                                   cancel=cancel, log=tuple(log), ask_unresolved=True)
             return ExploreStep("failure", "no frontier left", cancel=cancel, log=tuple(log))
         if pose is not None and (ledger.look_spot is None or
                                  math.hypot(pose.x - ledger.look_spot[0], pose.y - ledger.look_spot[1]) > s.look_spot_m):

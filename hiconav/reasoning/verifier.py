@@ -301,23 +301,28 @@ class OfflineVerifier:
 
     @staticmethod
     def _best_view(obj: ObjectLike, anchors: Sequence[AnchorLike]) -> tuple[AnchorLike, np.ndarray] | None:
-        """The anchor of the subgraph where ``obj``'s box is largest, and that box."""
-        best = None
-        for anchor in anchors:
-            ids = list(anchor.object_ids)
-            if obj.id not in ids:
-                continue
-            j = ids.index(obj.id)
-            boxes = np.asarray(anchor.boxes, dtype=float).reshape(-1, 4)
-            if j >= len(boxes):
-                continue
-            box = np.clip(boxes[j], 0.0, 1.0)
-            area = (box[2] - box[0]) * (box[3] - box[1])
-            if not np.all(np.isfinite(box)) or box[2] <= box[0] or box[3] <= box[1]:
-                continue
-            if best is None or area > best[0]:
-                best = (area, anchor, box)
-        return None if best is None else (best[1], best[2])
+        return best_view(obj, anchors)
+
+
+def best_view(obj: ObjectLike, anchors: Sequence[AnchorLike]) -> tuple[AnchorLike, np.ndarray] | None:
+    """The anchor of ``anchors`` where ``obj``'s image box is largest, and that box (normalised
+    xyxy); None when no anchor holds a valid box of it."""
+    best = None
+    for anchor in anchors:
+        ids = list(anchor.object_ids)
+        if obj.id not in ids:
+            continue
+        j = ids.index(obj.id)
+        boxes = np.asarray(anchor.boxes, dtype=float).reshape(-1, 4)
+        if j >= len(boxes):
+            continue
+        box = np.clip(boxes[j], 0.0, 1.0)
+        area = (box[2] - box[0]) * (box[3] - box[1])
+        if not np.all(np.isfinite(box)) or box[2] <= box[0] or box[3] <= box[1]:
+            continue
+        if best is None or area > best[0]:
+            best = (area, anchor, box)
+    return None if best is None else (best[1], best[2])
 
 
 def make_verifier(config: ReasoningConfig | None = None,

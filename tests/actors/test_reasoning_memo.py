@@ -95,3 +95,44 @@ def test_relations_that_fail_rule_instances_out_for_exploration_until_judged_aga
     node._set_task("find the bed by the sofa")
     _tick(node, SimpleNamespace(objects=(), anchors=(), stamp=0.4), 0.4)
     assert [o.msg.object_ids for o in node.drain() if isinstance(o.msg, RuledOut)] == [frozenset({5})]
+
+
+def test_explored_out_offers_the_best_unresolved_candidate_once_each():
+    import numpy as np
+
+    from hiconav.messages import ExploredOut, HypothesisMsg
+
+    class _Queue(_Reasoner):
+        def next(self):
+            return SimpleNamespace(kind="target", signature=(1,))
+
+        def accept(self, result):
+            pass
+
+    class _Verifier:
+        def verify(self, subgraph, task):
+            return SimpleNamespace(found=False, hypothesis=None, reason="relation_unknown", detail="",
+                                   latency_s=0.0, source="offline", verdicts={4: "unknown", 5: "fails"})
+
+    node = ReasoningNode(parse=lambda text: text, make_reasoner=lambda task: _Queue(), verifier=_Verifier(),
+                         decompose=lambda memory, task, similarity, k=5: [], latency_s=0.0)
+    node._set_task(SimpleNamespace(targets=("tv",), relations=(("tv", "in", "bedroom"),)))
+    objects = (SimpleNamespace(id=4, label="tv", confidence=0.4, n_obs=3),
+               SimpleNamespace(id=5, label="tv", confidence=0.9, n_obs=9))
+    anchors = (SimpleNamespace(id=1, object_ids=(4, 5), boxes=np.array([[0.1, 0.1, 0.3, 0.3], [0.5, 0.5, 0.9, 0.9]])),)
+    memory = SimpleNamespace(objects=objects, anchors=anchors, stamp=0.1)
+    _tick(node, memory, 0.1)
+    node.drain()
+
+    def offered(t: float) -> list:
+        node.receive(ExploredOut(t), t)
+        _tick(node, memory, t)
+        return [o.msg.hypothesis.object_id for o in node.drain() if isinstance(o.msg, HypothesisMsg) and o.dest == "mission"]
+
+    assert offered(0.2) == [4]  # unknown before ruled out
+    assert offered(0.3) == [5]  # then the next one, never the same twice
+    assert offered(0.4) == []  # none left
+    assert [e["found"] for e in node.events if e["kind"] == "unresolved"] == [True, True, False]
+    # nothing asked: nothing offered
+    _tick(node, memory, 0.5)
+    assert not [o for o in node.drain() if isinstance(o.msg, HypothesisMsg)]

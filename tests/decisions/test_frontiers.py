@@ -168,3 +168,19 @@ def test_a_look_is_a_quarter_turn_left_in_place():
     goal = look_goal(Pose2D(1.0, 2.0, math.pi))
     assert (goal.kind, goal.x, goal.y, goal.frontier) == ("look", 1.0, 2.0, None)
     assert goal.yaw == pytest.approx(-math.pi / 2)
+
+
+def test_explored_out_asks_for_the_best_unresolved_candidate_while_asks_are_left():
+    f, ledger = FrontierFollower(), _ledger(last_frontier_time=0.0)
+    ledger.unresolved_asks_left = 1
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 100.0, _plan(), ledger, {}, NO_START)
+    assert step.status == "running" and step.ask_unresolved and ledger.last_frontier_time == 100.0
+    assert ledger.unresolved_asks_left == 0
+    # one more idle period without an answer that ended the search: the search fails
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 100.0 + NO_START.max_idle_s + 1.0, _plan(), ledger, {}, NO_START)
+    assert step.status == "failure" and not step.ask_unresolved
+    # deferred candidates go first: they are the mission's own
+    ledger = _ledger(last_frontier_time=0.0)
+    ledger.unresolved_asks_left = 1
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 100.0, _plan(), ledger, {5: 130.0}, NO_START)
+    assert step.release_deferred and not step.ask_unresolved and ledger.unresolved_asks_left == 1

@@ -129,6 +129,33 @@ def test_explore_fails_when_no_frontier_is_left(tmp_path):
     assert tree.tick() == S.FAILURE
 
 
+def test_explored_out_search_of_a_described_instance_asks_the_reasoning_layer_first(tmp_path):
+    from hiconav.messages import ExploredOut
+
+    def explored_out(task: TaskSpec, **kw) -> tuple[list, list]:
+        clock = Clock()
+        ctx = _ctx(clock, **kw)
+        ctx.task = task
+        ctx.plan = plan()
+        tree = MissionTree(_write(tmp_path, "root:\n  Explore: {max_idle_s: 3, unresolved_asks: 2}\n"), ctx)
+        statuses = []
+        for t in (0.0, 3.5, 7.0, 10.5, 14.0):
+            clock.t = t
+            statuses.append(tree.tick())
+            if statuses[-1] == S.FAILURE:
+                break
+        return statuses, [m for m in ctx.outbox if isinstance(m, ExploredOut)]
+
+    described = TaskSpec("the bed under the painting", ("bed",), ("painting",),
+                         relations=(("bed", "under", "painting"),))
+    statuses, asked = explored_out(described)
+    assert statuses == [S.RUNNING, S.RUNNING, S.RUNNING, S.FAILURE] and len(asked) == 2
+    # an object goal, or a described one without the reasoning layer: labels decide, nobody to ask
+    for task, kw in ((TaskSpec("find the bed", ("bed",)), {}), (described, {"reasoning": False})):
+        statuses, asked = explored_out(task, **kw)
+        assert statuses == [S.RUNNING, S.FAILURE] and not asked
+
+
 def test_explore_moves_on_when_a_frontier_is_unreachable(tmp_path):
     clock = Clock()
     ctx = _ctx(clock)

@@ -40,7 +40,7 @@ class Explore(MissionBehaviour):
         ctx = self.context
         ledger = ExploreLedger(ctx.last_frontier_time, ctx.start_looks, ctx.look_spot, ctx.looks_here,
                                ctx.spent_viewpoints, ctx.pushed_frontiers, ctx.failed_frontiers,
-                               ctx.squeezed_frontiers)
+                               ctx.squeezed_frontiers, self._asks_left())
         state = None if self._seq is None else ctx.nav_state(self._seq)
         step = self._follower.step(state, ctx.pose, ctx.now(), PlanView.of(ctx.plan), ledger, ctx.deferred,
                                    self.settings)
@@ -57,8 +57,18 @@ class Explore(MissionBehaviour):
             self._seq = ctx.send_goal(_goal(step.goal))
         if step.release_deferred:
             ctx.deferred.clear()
+        if step.ask_unresolved:
+            ctx.report_explored_out()
         self.feedback_message = step.feedback
         return Status.FAILURE if step.status == "failure" else Status.RUNNING
+
+    def _asks_left(self) -> int:
+        """Asks for an unresolved candidate left: only a described instance that the reasoning
+        layer decides has them."""
+        ctx = self.context
+        if not (ctx.reasoning and ctx.described):
+            return 0
+        return max(int(self.settings.unresolved_asks) - ctx.unresolved_asks, 0)
 
     def cleanup(self, new_status: Status) -> None:
         if getattr(self, "_seq", None) is not None and self.ctx is not None:

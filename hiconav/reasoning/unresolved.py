@@ -1,0 +1,74 @@
+"""The best unresolved candidate of a described instance, once the search has nothing left.
+
+A described instance ("the TV in the bedroom") is confirmed only when every relation holds on the
+memory graph. When the robot has explored every frontier and no instance was confirmed, the
+instances it did see are all that is left: one whose relation is *unknown* (the lamp it stands
+by, or the room's cues, were never in view with it), or whose relations held but whose detection
+stayed below the verifier's gates, or even one the relations ruled out (a room inferred wrongly
+from a few cues). Ending the mission with none of them is a certain failure; going to the most
+plausible one is not. This module ranks them; the reasoning node offers the first as a
+hypothesis when the mission reports the search explored out (``ExploredOut``), and the mission
+verifies it (re-detection) like any other before it stops.
+
+Order: verdict "holds" (gated out by confidence or observations) before "unknown" before "fails";
+then the detection evidence, confidence x observations; then the lower id (older node). Pure: no
+clocks, no I/O.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection, Mapping, Sequence
+from typing import Any
+
+from hiconav.reasoning.hypothesis import TargetHypothesis
+from hiconav.reasoning.verifier import best_view
+
+__all__ = ["VERDICT_RANK", "best_unresolved", "unresolved_hypothesis"]
+
+# a verdict's place in the order (lower first); verdicts not listed are never offered
+VERDICT_RANK: dict[str, int] = {"holds": 0, "unknown": 1, "fails": 2}
+
+
+def _norm(label: str) -> str:
+    return label.strip().lower().replace(" ", "_").replace("-", "_")
+
+
+def best_unresolved(objects: Sequence[Any], verdicts: Mapping[int, str], targets: Sequence[str],
+                    exclude: Collection[int] = ()) -> Any | None:
+    """The object node to offer, or None: among ``objects`` (memory ObjectViews: ``id``, ``label``,
+    ``confidence``, ``n_obs``) labelled as one of ``targets`` and judged (``verdicts``: object id
+    -> "holds" / "unknown" / "fails"), not in ``exclude`` (offered or rejected already), the first
+    by verdict, then confidence x observations, then id."""
+    names = {_norm(t) for t in targets}
+    pool = [o for o in objects
+            if _norm(str(o.label)) in names and verdicts.get(int(o.id)) in VERDICT_RANK
+            and int(o.id) not in exclude]
+    if not pool:
+        return None
+    return min(pool, key=lambda o: (VERDICT_RANK[verdicts[int(o.id)]],
+                                    -float(o.confidence) * int(o.n_obs), int(o.id)))
+
+
+def unresolved_hypothesis(memory: Any, verdicts: Mapping[int, str], targets: Sequence[str],
+                          exclude: Collection[int] = ()) -> TargetHypothesis | None:
+    """``best_unresolved`` on a memory snapshot (``objects``, ``anchors``) as a hypothesis: the
+    anchor where the node's box is largest, confidence the node's detector confidence, source
+    "offline" and evidence saying it is a fallback. None when no node qualifies or no anchor
+    holds the chosen node's box."""
+    objects = list(getattr(memory, "objects", ()) or ())
+    node = best_unresolved(objects, verdicts, targets, exclude)
+    if node is None:
+        return None
+    view = best_view(node, list(getattr(memory, "anchors", ()) or ()))
+    if view is None:
+        return None
+    anchor, bbox = view
+    verdict = verdicts[int(node.id)]
+    label = next((t for t in targets if _norm(t) == _norm(str(node.label))), str(node.label))
+    evidence = (f"offline fallback, the search explored out: object node {node.id} labelled "
+                f"{node.label!r} is the best unresolved candidate (relations {verdict}, detector "
+                f"confidence {float(node.confidence):.2f}, seen {int(node.n_obs)} times)")
+    return TargetHypothesis(anchor_id=int(anchor.id), object_id=int(node.id), bbox=bbox,
+                            confidence=float(node.confidence), evidence=evidence, latency_s=0.0,
+                            source="offline", subgraph_signature=("unresolved", int(node.id)),
+                            label=label)
