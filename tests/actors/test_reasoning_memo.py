@@ -23,6 +23,16 @@ class _Reasoner:
         return None
 
 
+class _Queue(_Reasoner):
+    """Always one target subgraph to verify; results are dropped."""
+
+    def next(self):
+        return SimpleNamespace(kind="target", signature=(1,))
+
+    def accept(self, result):
+        pass
+
+
 def _node() -> tuple[ReasoningNode, list, _Reasoner]:
     calls: list = []
     reasoner = _Reasoner()
@@ -69,13 +79,6 @@ def test_a_replaced_view_of_the_same_object_is_a_change():
 def test_relations_that_fail_rule_instances_out_for_exploration_until_judged_again():
     from hiconav.messages import RuledOut
 
-    class _Queue(_Reasoner):
-        def next(self):
-            return SimpleNamespace(kind="target", signature=(1,))
-
-        def accept(self, result):
-            pass
-
     replies = iter([{4: "fails", 5: "unknown"}, {4: "fails", 5: "fails"}, {4: "holds"}, {5: "fails"}])
 
     class _Verifier:
@@ -101,13 +104,6 @@ def test_explored_out_offers_the_best_unresolved_candidate_once_each():
     import numpy as np
 
     from hiconav.messages import ExploredOut, HypothesisMsg
-
-    class _Queue(_Reasoner):
-        def next(self):
-            return SimpleNamespace(kind="target", signature=(1,))
-
-        def accept(self, result):
-            pass
 
     class _Verifier:
         def verify(self, subgraph, task):
