@@ -165,7 +165,6 @@ class ReasoningNode(Node):
             self.emit(("mission", "memory", "recorder"), HypothesisMsg(result.hypothesis, now + delay, now, "", result.detail,
                                                            str(getattr(subgraph, "kind", ""))), delay)
 
-
     def _offer_unresolved(self, now: float) -> bool:
         """The search explored out: send the best unresolved candidate of a described instance
         (``hiconav.reasoning.unresolved``) as a hypothesis, one not offered before; a reasoning

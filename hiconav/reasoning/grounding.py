@@ -179,7 +179,8 @@ class Grounding:
     evidence: tuple[str, ...]
 
 
-def _labels_match(label: str, name: str) -> bool:
+def labels_match(label: str, name: str) -> bool:
+    """True when two labels name one thing (case, spaces and underscores aside)."""
     return label.strip().lower().replace(" ", "_") == name.strip().lower().replace(" ", "_")
 
 
@@ -219,12 +220,12 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
         if seen is None:
             return "unknown", "no room cue seen with it"
         return ("holds" if seen == room else "fails"), f"inferred {seen} (evidence {score:.1f})"
-    others = [o for o in objects if o.id != node.id and _labels_match(o.label, obj)]
+    others = [o for o in objects if o.id != node.id and labels_match(o.label, obj)]
     if not others:
         return "unknown", f"no {obj} in view"
     # the related object's own relations ("the floor lamp in the living room"), checked one level down
     nested = [(r, o2) for s2, r, o2 in (tuple(x) for x in relations)
-              if _labels_match(s2, obj) and not _labels_match(o2, node.label)] if depth == 0 else []
+              if labels_match(s2, obj) and not labels_match(o2, node.label)] if depth == 0 else []
     best = "fails"
     line = ""
     for other in sorted(others, key=lambda o: planar_gap(node, o)):

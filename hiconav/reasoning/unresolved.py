@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Collection, Mapping, Sequence
 from typing import Any
 
+from hiconav.reasoning.grounding import labels_match
 from hiconav.reasoning.hypothesis import TargetHypothesis
 from hiconav.reasoning.verifier import best_view
 
@@ -29,19 +30,14 @@ __all__ = ["VERDICT_RANK", "best_unresolved", "unresolved_hypothesis"]
 VERDICT_RANK: dict[str, int] = {"holds": 0, "unknown": 1, "fails": 2}
 
 
-def _norm(label: str) -> str:
-    return label.strip().lower().replace(" ", "_").replace("-", "_")
-
-
 def best_unresolved(objects: Sequence[Any], verdicts: Mapping[int, str], targets: Sequence[str],
                     exclude: Collection[int] = ()) -> Any | None:
     """The object node to offer, or None: among ``objects`` (memory ObjectViews: ``id``, ``label``,
     ``confidence``, ``n_obs``) labelled as one of ``targets`` and judged (``verdicts``: object id
     -> "holds" / "unknown" / "fails"), not in ``exclude`` (offered or rejected already), the first
     by verdict, then confidence x observations, then id."""
-    names = {_norm(t) for t in targets}
     pool = [o for o in objects
-            if _norm(str(o.label)) in names and verdicts.get(int(o.id)) in VERDICT_RANK
+            if any(labels_match(str(o.label), t) for t in targets) and verdicts.get(int(o.id)) in VERDICT_RANK
             and int(o.id) not in exclude]
     if not pool:
         return None
@@ -64,7 +60,7 @@ def unresolved_hypothesis(memory: Any, verdicts: Mapping[int, str], targets: Seq
         return None
     anchor, bbox = view
     verdict = verdicts[int(node.id)]
-    label = next((t for t in targets if _norm(t) == _norm(str(node.label))), str(node.label))
+    label = next((t for t in targets if labels_match(str(node.label), t)), str(node.label))
     evidence = (f"offline fallback, the search explored out: object node {node.id} labelled "
                 f"{node.label!r} is the best unresolved candidate (relations {verdict}, detector "
                 f"confidence {float(node.confidence):.2f}, seen {int(node.n_obs)} times)")
