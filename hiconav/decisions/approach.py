@@ -15,7 +15,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from hiconav.decisions.config import ApproachSettings
-from hiconav.decisions.geometry import facing, wall_clear
+from hiconav.decisions.geometry import facing, rounded_box_distance, wall_clear
 from hiconav.mapping.occupancy import lethal_mask
 from hiconav.types import Goal, wrap_angle
 
@@ -40,7 +40,8 @@ class RingTry(NamedTuple):
 def gap(robot_xy: np.ndarray, box_min: np.ndarray, box_max: np.ndarray, points: Any,
         settings: ApproachSettings) -> Gap:
     """The robot's distance from ``robot_xy`` (2,) world to the object by ``settings.measure``: to
-    the nearest point of its box's footprint (``box_min``/``box_max`` (3,) world), or, with
+    its box's footprint (``box_min``/``box_max`` (3,) world) with the corners rounded by
+    ``settings.corner_radius`` (``near``: the box's nearest point), or, with
     ``points`` (N, 3) world and at least ``min_points`` of them, to its points'
     ``points_quantile`` planar distance.
 
@@ -57,7 +58,7 @@ def gap(robot_xy: np.ndarray, box_min: np.ndarray, box_max: np.ndarray, points: 
             i = int(np.argpartition(d, k)[k])
             return Gap(float(d[i]), pts[i, :2].copy())
     near = np.clip(robot, lo[:2], hi[:2])
-    return Gap(float(np.hypot(*(near - robot))), near)
+    return Gap(float(rounded_box_distance(robot[0], robot[1], lo, hi, settings.corner_radius)), near)
 
 
 def rings(settings: ApproachSettings) -> list[float]:

@@ -15,6 +15,25 @@ import numpy as np
 from hiconav.mapping.occupancy import lethal_mask
 
 
+def rounded_box_distance(x: np.ndarray | float, y: np.ndarray | float, box_min: np.ndarray, box_max: np.ndarray,
+                         corner_radius: float = 0.0) -> np.ndarray:
+    """Planar distance (m) from world points (``x``, ``y``, arrays of one shape) to a box's
+    footprint (``box_min`` / ``box_max`` (3,) world, x and y used) with its corners rounded by
+    ``corner_radius`` (at most the half of its shorter side); 0 inside. 0: the box's own distance.
+
+    A memory box is axis-aligned around what the camera saw of an object, and most objects are
+    not rectangles that fill it: a plant, a round table, a chair's legs, an object turned in the
+    room leave its corners empty. Beside a face the box is as near as the object; off a corner,
+    on the diagonal, the object lies up to (sqrt(2) - 1) x the radius farther than the box."""
+    lo, hi = np.asarray(box_min, dtype=np.float64), np.asarray(box_max, dtype=np.float64)
+    cx, cy = 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])
+    hx, hy = max(0.5 * (hi[0] - lo[0]), 0.0), max(0.5 * (hi[1] - lo[1]), 0.0)
+    r = float(np.clip(corner_radius, 0.0, min(hx, hy)))
+    qx = np.maximum(np.abs(np.asarray(x, dtype=np.float64) - cx) - (hx - r), 0.0)
+    qy = np.maximum(np.abs(np.asarray(y, dtype=np.float64) - cy) - (hy - r), 0.0)
+    return np.maximum(np.hypot(qx, qy) - r, 0.0)
+
+
 def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy: np.ndarray,
                   max_distance: float, exclude: list[np.ndarray] | None = None,
                   tight: bool = False, centre_weight: float = 0.0, prefer_xy: np.ndarray | None = None,
@@ -22,7 +41,7 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
                   furniture: list[tuple[np.ndarray, np.ndarray]] | None = None,
                   strict_walls: bool = False, box_weight: float = 0.0,
                   wall_heights: tuple[float, float] | None = None, connected: bool = True,
-                  prefer_roomy: bool = True) -> np.ndarray | None:
+                  prefer_roomy: bool = True, corner_radius: float = 0.0) -> np.ndarray | None:
     """A free, non-inflated grid cell connected to the robot within ``max_distance`` of a footprint.
 
     grid: snapshot with ``state`` (H, W) int8 (0 free), ``inflated`` (H, W) bool, ``origin`` (2,),
@@ -52,7 +71,8 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     ``connected=False`` drops the first condition: any free cell will do, for a goal the robot
     is to reach through unknown floor (``VerifyTarget._send_through_unknown``). With ``tight``,
     ``prefer_roomy=False`` weighs cells only the robot radius clears as the others (for a robot
-    that already stands in such a passage).
+    that already stands in such a passage). Distances to the footprint are to the box with its
+    corners rounded by ``corner_radius`` (``rounded_box_distance``; 0: the box).
     """
     from scipy import ndimage
 
@@ -78,9 +98,8 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
     rows, cols = np.mgrid[r0:r1, c0:c1]
     x = ox + (cols + 0.5) * res
     y = oy + (rows + 0.5) * res
-    dx = np.maximum(np.maximum(box_min[0] - x, 0.0), x - box_max[0])
-    dy = np.maximum(np.maximum(box_min[1] - y, 0.0), y - box_max[1])
-    ok = (np.hypot(dx, dy) <= max_distance) & free[r0:r1, c0:c1]
+    to_box = rounded_box_distance(x, y, box_min, box_max, corner_radius)
+    ok = (to_box <= max_distance) & free[r0:r1, c0:c1]
     if robot_label and connected:
         ok &= labels[r0:r1, c0:c1] == robot_label
     for ex in exclude or []:
@@ -107,7 +126,7 @@ def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy:
             ok = _only(ok, idx[clear])
     cost = np.hypot(x - robot_xy[0], y - robot_xy[1])
     if box_weight > 0.0:
-        cost = cost + box_weight * np.hypot(dx, dy)
+        cost = cost + box_weight * to_box
     if centre_weight > 0.0:
         cost = cost + centre_weight * np.hypot(x - centre[0], y - centre[1])
     if prefer_xy is not None and prefer_weight > 0.0:
@@ -218,4 +237,4 @@ def anchor_sees(anchor: Any, point: np.ndarray, blockers: tuple[np.ndarray, np.n
     return not bool(segments_blocked(T[None, :3, 3], point, *blockers)[0])
 
 
-__all__ = ["anchor_sees", "approach_cell", "facing", "segments_blocked", "wall_clear"]
+__all__ = ["anchor_sees", "approach_cell", "facing", "rounded_box_distance", "segments_blocked", "wall_clear"]

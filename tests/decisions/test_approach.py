@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from hiconav.decisions import approach as plan
+from hiconav.decisions import geometry
 from hiconav.decisions.config import ApproachSettings
 
 from .fakes import Grid
@@ -35,8 +36,37 @@ def straight(grid: Grid, robot: tuple[float, float], s: ApproachSettings = Appro
 
 
 def test_a_box_is_measured_to_the_nearest_point_of_its_footprint():
-    g = plan.gap(np.array([3.5, 6.0]), LO, HI, None, ApproachSettings())
+    g = plan.gap(np.array([3.5, 6.0]), LO, HI, None, ApproachSettings(corner_radius=0.0))
     assert g.distance == pytest.approx(math.hypot(1.0, 0.5)) and np.allclose(g.near, [4.5, 5.5])
+
+
+def test_a_box_is_measured_with_its_corners_rounded():
+    """Beside a face the rounded box is the box; off a corner, on the diagonal, it is (sqrt(2) - 1)
+    x the radius farther (a plant or chair leaves its box's corners empty); the radius is at most
+    half the shorter side, and 0 gives the box."""
+    s = ApproachSettings()
+    assert s.corner_radius == pytest.approx(0.3)
+    side = plan.gap(np.array([3.5, 5.2]), LO, HI, None, s)
+    assert side.distance == pytest.approx(1.0) and np.allclose(side.near, [4.5, 5.2])
+    corner = np.array([4.5 - 0.6, 4.5 - 0.6])
+    assert plan.gap(corner, LO, HI, None, s).distance == pytest.approx(math.hypot(0.9, 0.9) - 0.3)
+    assert plan.gap(corner, LO, HI, None, ApproachSettings(corner_radius=0.0)).distance == \
+        pytest.approx(math.hypot(0.6, 0.6))
+    # a 0.2 m deep box (a painting on its wall): the radius stops at 0.1 m
+    thin = geometry.rounded_box_distance(4.0, 4.0, np.array([4.5, 4.5, 0.0]), np.array([5.5, 4.7, 1.0]), 0.3)
+    assert float(thin) == pytest.approx(math.hypot(0.6, 0.6) - 0.1)
+    assert float(geometry.rounded_box_distance(5.0, 5.0, LO, HI, 0.3)) == 0.0  # inside
+
+
+def test_approach_cells_keep_the_success_distance_off_a_corner_too():
+    """The ring's cells lie within the distance of the rounded box: a cell on the box's diagonal
+    ring (0.85 m from its corner) is 0.97 m from a round object the box holds, and is not taken."""
+    grid = room()
+    robot = np.array([2.0, 2.0])
+    for r in (0.0, 0.3):
+        cell = geometry.approach_cell(grid, LO, HI, robot, 0.85, corner_radius=r)
+        d = float(geometry.rounded_box_distance(cell[0], cell[1], LO, HI, 0.3))
+        assert (d > 0.85) if r == 0.0 else (d <= 0.85 + 1e-9)
 
 
 def test_by_points_a_robot_off_a_round_objects_diagonal_is_as_far_as_its_nearest_points_not_its_box_corner():
@@ -44,7 +74,7 @@ def test_by_points_a_robot_off_a_round_objects_diagonal_is_as_far_as_its_nearest
     angles = np.linspace(0.0, 2.0 * math.pi, 200, endpoint=False)
     pts = np.stack([5.0 + 0.5 * np.cos(angles), 5.0 + 0.5 * np.sin(angles), np.full(200, 0.4)], axis=1)
     robot = np.array([4.0, 4.0])
-    by_box = plan.gap(robot, LO, HI, pts, ApproachSettings())
+    by_box = plan.gap(robot, LO, HI, pts, ApproachSettings(corner_radius=0.0))
     by_points = plan.gap(robot, LO, HI, pts, ApproachSettings(measure="points"))
     assert by_box.distance == pytest.approx(math.hypot(0.5, 0.5))
     assert by_points.distance == pytest.approx(math.hypot(1.0, 1.0) - 0.5, abs=0.01)

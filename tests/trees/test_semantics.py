@@ -842,7 +842,7 @@ def test_approach_measures_to_the_objects_points_when_told_to(tmp_path):
     def first_goal(measure: str):
         ctx = _ctx(Clock())
         ctx.world = world(pose, [plant])
-        tree = _confirmed_then(tmp_path, ctx, f"Approach: {{distance: 0.9, inner_margin: 0.0, measure: {measure}}}")
+        tree = _confirmed_then(tmp_path, ctx, f"Approach: {{distance: 0.9, inner_margin: 0.0, measure: {measure}, corner_radius: 0.0}}")
         assert tree.tick() == S.RUNNING
         return _node(tree, "Approach"), [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
 
@@ -856,7 +856,7 @@ def test_approach_measures_to_the_objects_points_when_told_to(tmp_path):
     bare = obj(3, "bed", 5.0, 5.0)  # no points (a hand-made node): the box decides
     ctx = _ctx(Clock())
     ctx.world = world(pose, [bare])
-    tree = _confirmed_then(tmp_path, ctx, "Approach: {distance: 0.9, measure: points}")
+    tree = _confirmed_then(tmp_path, ctx, "Approach: {distance: 0.9, measure: points, corner_radius: 0.0}")
     tree.tick()
     approach = _node(tree, "Approach")
     assert approach._gap(approach.read("target"))[0] == pytest.approx(math.hypot(0.6, 0.6), abs=1e-9)

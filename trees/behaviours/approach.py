@@ -28,6 +28,9 @@ class Approach(_GoToObject):
     def _centre_weight(self) -> float:
         return self.param("centre_weight")
 
+    def _corner_radius(self) -> float:
+        return self.param("corner_radius")
+
     def initialise(self) -> None:
         self._start, self._seq, self._cell, self._attempts = self.context.now(), None, None, 0
         self._excluded: list[np.ndarray] = []  # approach cells that failed (world xy)

@@ -36,6 +36,10 @@ class _GoToObject(MissionBehaviour):
         """approach_cell's weight on a cell's distance to ``_preferred_xy`` (see VerifyTarget)."""
         return 0.0
 
+    def _corner_radius(self) -> float:
+        """approach_cell's rounding of the box's corners (see Approach); 0: the box."""
+        return 0.0
+
     def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
         """A point the approach cell should lie near, or None (no preference)."""
         return None
@@ -62,7 +66,7 @@ class _GoToObject(MissionBehaviour):
         rules = {"centre_weight": self._centre_weight(), "prefer_xy": self._preferred_xy(cand, distance),
                  "prefer_weight": self._prefer_weight(), "sight": self._sight(cand),
                  "furniture": self._furniture(cand), "strict_walls": strict_walls, "box_weight": box_weight,
-                 "wall_heights": self._wall_heights(cand)}
+                 "wall_heights": self._wall_heights(cand), "corner_radius": self._corner_radius()}
         cell = cell_near(ctx.grid, cand.box_min, cand.box_max, np.array([pose.x, pose.y]), distance, self._excluded,
                          **rules)
         if cell is None:
