@@ -15,7 +15,8 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from hiconav.decisions.config import ApproachSettings
-from hiconav.decisions.geometry import facing, rounded_box_distance, wall_clear
+from hiconav.decisions.geometry import facing, wall_clear
+from hiconav.geometry import rounded_box_distance
 from hiconav.mapping.occupancy import lethal_mask
 from hiconav.types import Goal, wrap_angle
 

@@ -158,8 +158,7 @@ class ApproachSettings(_Section):
     creep_s: float = _f(3.0, "clock seconds a creep may take (blocked by clutter it would rock on)", 0.1, 600.0)
     corner_radius: float = _f(0.3, "the robot's distance to the target is measured to its box with the corners rounded "
                               "by this (m, at most half the shorter side): most objects leave their box's corners "
-                              "empty, and a robot off a corner stood 1.03-1.06 m from a chair or plant its box put "
-                              "0.8 m away (0: the box)", 0.0, 5.0)
+                              "empty, so off a corner the object lies farther than the box (0: the box)", 0.0, 5.0)
     measure: Literal["box", "points"] = _f("box", "how far the robot is from the object: its memory box, or a "
                                                   "low quantile of its points' planar distances ('points')")
     points_quantile: float = _f(0.02, "with measure 'points', a node's points nearer than this quantile are its "

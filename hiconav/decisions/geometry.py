@@ -12,26 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from hiconav.geometry import rounded_box_distance
 from hiconav.mapping.occupancy import lethal_mask
-
-
-def rounded_box_distance(x: np.ndarray | float, y: np.ndarray | float, box_min: np.ndarray, box_max: np.ndarray,
-                         corner_radius: float = 0.0) -> np.ndarray:
-    """Planar distance (m) from world points (``x``, ``y``, arrays of one shape) to a box's
-    footprint (``box_min`` / ``box_max`` (3,) world, x and y used) with its corners rounded by
-    ``corner_radius`` (at most the half of its shorter side); 0 inside. 0: the box's own distance.
-
-    A memory box is axis-aligned around what the camera saw of an object, and most objects are
-    not rectangles that fill it: a plant, a round table, a chair's legs, an object turned in the
-    room leave its corners empty. Beside a face the box is as near as the object; off a corner,
-    on the diagonal, the object lies up to (sqrt(2) - 1) x the radius farther than the box."""
-    lo, hi = np.asarray(box_min, dtype=np.float64), np.asarray(box_max, dtype=np.float64)
-    cx, cy = 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])
-    hx, hy = max(0.5 * (hi[0] - lo[0]), 0.0), max(0.5 * (hi[1] - lo[1]), 0.0)
-    r = float(np.clip(corner_radius, 0.0, min(hx, hy)))
-    qx = np.maximum(np.abs(np.asarray(x, dtype=np.float64) - cx) - (hx - r), 0.0)
-    qy = np.maximum(np.abs(np.asarray(y, dtype=np.float64) - cy) - (hy - r), 0.0)
-    return np.maximum(np.hypot(qx, qy) - r, 0.0)
 
 
 def approach_cell(grid: Any, box_min: np.ndarray, box_max: np.ndarray, robot_xy: np.ndarray,
@@ -237,4 +219,4 @@ def anchor_sees(anchor: Any, point: np.ndarray, blockers: tuple[np.ndarray, np.n
     return not bool(segments_blocked(T[None, :3, 3], point, *blockers)[0])
 
 
-__all__ = ["anchor_sees", "approach_cell", "facing", "rounded_box_distance", "segments_blocked", "wall_clear"]
+__all__ = ["anchor_sees", "approach_cell", "facing", "segments_blocked", "wall_clear"]

@@ -11,6 +11,7 @@ import pytest
 
 from hiconav.decisions import approach as plan
 from hiconav.decisions import geometry
+from hiconav.geometry import rounded_box_distance
 from hiconav.decisions.config import ApproachSettings
 
 from .fakes import Grid
@@ -53,9 +54,9 @@ def test_a_box_is_measured_with_its_corners_rounded():
     assert plan.gap(corner, LO, HI, None, ApproachSettings(corner_radius=0.0)).distance == \
         pytest.approx(math.hypot(0.6, 0.6))
     # a 0.2 m deep box (a painting on its wall): the radius stops at 0.1 m
-    thin = geometry.rounded_box_distance(4.0, 4.0, np.array([4.5, 4.5, 0.0]), np.array([5.5, 4.7, 1.0]), 0.3)
+    thin = rounded_box_distance(4.0, 4.0, np.array([4.5, 4.5, 0.0]), np.array([5.5, 4.7, 1.0]), 0.3)
     assert float(thin) == pytest.approx(math.hypot(0.6, 0.6) - 0.1)
-    assert float(geometry.rounded_box_distance(5.0, 5.0, LO, HI, 0.3)) == 0.0  # inside
+    assert float(rounded_box_distance(5.0, 5.0, LO, HI, 0.3)) == 0.0  # inside
 
 
 def test_approach_cells_keep_the_success_distance_off_a_corner_too():
@@ -65,7 +66,7 @@ def test_approach_cells_keep_the_success_distance_off_a_corner_too():
     robot = np.array([2.0, 2.0])
     for r in (0.0, 0.3):
         cell = geometry.approach_cell(grid, LO, HI, robot, 0.85, corner_radius=r)
-        d = float(geometry.rounded_box_distance(cell[0], cell[1], LO, HI, 0.3))
+        d = float(rounded_box_distance(cell[0], cell[1], LO, HI, 0.3))
         assert (d > 0.85) if r == 0.0 else (d <= 0.85 + 1e-9)
 
 
