@@ -436,8 +436,9 @@ class MavlinkDriver:
                 self._acks.pop(command, None)
                 n_text = len(self._statustext)
                 target = self.target_system or 0
-            with self._send_lock:
-                self._conn.mav.command_long_send(target, self.target_component, command, attempt, *p)
+            if not self._send(self._conn.mav.command_long_send,
+                              target, self.target_component, command, attempt, *p):
+                continue  # counted in stats["send_errors"]; the next attempt sends again
             deadline = sent_at + cfg.ack_timeout_s
             with self._changed:
                 while command not in self._acks and self._clock() < deadline:
@@ -477,13 +478,10 @@ class MavlinkDriver:
         if self.target_system is None or self._conn is None:
             return
         ms = int((self._clock() - self._t0) * 1000) & 0xFFFFFFFF
-        try:
-            with self._send_lock:
-                self._conn.mav.set_position_target_local_ned_send(
-                    ms, self.target_system, self.target_component, mavlink.MAV_FRAME_BODY_NED,
-                    VELOCITY_YAWRATE_MASK, 0.0, 0.0, 0.0, float(v), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -float(omega))
-        except (OSError, ValueError):
-            self.stats["send_errors"] += 1
+        if not self._send(self._conn.mav.set_position_target_local_ned_send,
+                          ms, self.target_system, self.target_component, mavlink.MAV_FRAME_BODY_NED,
+                          VELOCITY_YAWRATE_MASK, 0.0, 0.0, 0.0, float(v), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                          -float(omega)):
             return
         with self._lock:
             self._last_sent = (float(v), float(omega))
@@ -493,17 +491,40 @@ class MavlinkDriver:
 
     def _send_heartbeat(self) -> None:
         """Our GCS heartbeat (MAV_TYPE_GCS, MAV_AUTOPILOT_INVALID)."""
+        self._send(self._conn.mav.heartbeat_send, mavlink.MAV_TYPE_GCS, mavlink.MAV_AUTOPILOT_INVALID,
+                   0, 0, mavlink.MAV_STATE_ACTIVE)
+
+    def _send(self, send: Callable[..., Any], *args: Any) -> bool:
+        """Send one message; False (counted in ``stats["send_errors"]``) if the send failed.
+
+        Any exception counts, not only socket errors: pymavlink's ``udpin`` write iterates the
+        set of peers that the receiver thread grows (``RuntimeError: Set changed size during
+        iteration``), and a full buffer or a closed port raises ``OSError``. A failed send is a
+        lost message, like one the link drops: the caller goes on, and a stream that stays
+        silent stops the robot through the vehicle's own setpoint timeout.
+        """
         try:
             with self._send_lock:
-                self._conn.mav.heartbeat_send(mavlink.MAV_TYPE_GCS, mavlink.MAV_AUTOPILOT_INVALID,
-                                              0, 0, mavlink.MAV_STATE_ACTIVE)
-        except (OSError, ValueError):
+                send(*args)
+        except Exception as exc:  # noqa: BLE001 - see above: a send must never end a sender loop
             self.stats["send_errors"] += 1
+            if self.stats["send_errors"] == 1 or self.stats["send_errors"] % 100 == 0:
+                _log.warning("MAVLink send failed (%d so far): %s: %s",
+                            self.stats["send_errors"], type(exc).__name__, exc)
+            return False
+        return True
 
     def _tx_loop(self) -> None:
         self._next_tick = self._next_hb = self._clock()
+        period = 1.0 / self.profile.rates.setpoint_hz
         while not self._stop_event.is_set():
-            wake = self._tick(self._clock())
+            try:
+                wake = self._tick(self._clock())
+            except Exception:  # noqa: BLE001 - the sender must outlive any one tick's failure
+                self.stats["tx_errors"] += 1
+                _log.exception("MAVLink sender tick failed (%d so far); the loop goes on",
+                              self.stats["tx_errors"])
+                wake = self._clock() + period
             self._stop_event.wait(max(0.0, wake - self._clock()))
 
     _next_tick: float | None = None

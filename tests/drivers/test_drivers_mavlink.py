@@ -121,6 +121,50 @@ def test_velocity_is_clamped_and_nan_ignored(make_link):
     assert wait_until(lambda: vehicle.state().last_command == (0.0, 0.0), 1.0)
 
 
+def test_failed_sends_do_not_end_the_setpoint_stream(make_link):
+    # pymavlink's udpin write can raise mid-send (RuntimeError when the receiver thread adds a
+    # peer while the sender iterates them; OSError on a full buffer): each failed send is a lost
+    # message, counted, and the sender thread streams on.
+    vehicle, driver, _ = make_link()
+    real_send = driver._conn.mav.send
+    failures = {"left": 5}
+
+    def flaky_send(msg, *args, **kwargs):
+        if failures["left"] > 0:
+            failures["left"] -= 1
+            raise (RuntimeError("Set changed size during iteration") if failures["left"] % 2
+                   else OSError("No buffer space available"))
+        return real_send(msg, *args, **kwargs)
+
+    driver._conn.mav.send = flaky_send
+    assert wait_until(lambda: failures["left"] == 0, 2.0)
+    assert driver.stats["send_errors"] >= 5
+    assert all(t.is_alive() for t in driver._threads)
+    driver.send(VelocityCommand(0.5, 0.0))
+    assert wait_until(lambda: vehicle.state().v > 0.4, 2.0)
+    n0 = vehicle.state().counters.get("setpoints", 0)
+    assert wait_until(lambda: vehicle.state().counters.get("setpoints", 0) >= n0 + 5, 2.0)
+
+
+def test_a_failing_tick_does_not_end_the_sender(make_link):
+    # whatever one tick raises (a bug, a failsafe input it cannot read), the loop goes on
+    vehicle, driver, _ = make_link()
+    real_tick = driver._tick
+    failures = {"left": 3}
+
+    def flaky_tick(now):
+        if failures["left"] > 0:
+            failures["left"] -= 1
+            raise ValueError("malformed state")
+        return real_tick(now)
+
+    driver._tick = flaky_tick
+    assert wait_until(lambda: failures["left"] == 0, 2.0)
+    assert driver.stats["tx_errors"] == 3
+    driver.send(VelocityCommand(0.5, 0.0))
+    assert wait_until(lambda: vehicle.state().v > 0.4, 2.0)
+
+
 # ---------------------------------------------------------------- refusals
 def test_refused_mode_change_is_reported(make_link):
     vehicle, driver, _ = make_link(VehicleConfig(refuse_modes=frozenset({"GUIDED"})), engage=False)
