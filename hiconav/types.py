@@ -15,6 +15,7 @@ Frames and conventions (used everywhere in the project):
 from __future__ import annotations
 
 import enum
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -57,6 +58,19 @@ def check_intrinsics(k: Any, where: str = "intrinsics") -> None:
         v = getattr(k, name, None)
         if not _finite(v):
             raise FrameError(f"principal point {name} must be finite, got {v!r}", field=f"{where}.{name}")
+
+
+@functools.lru_cache(maxsize=8192)
+def label_key(label: str) -> str:
+    """The key two labels are compared by: lowercase snake case, spaces and hyphens as
+    underscores, runs of them as one ("Floor Lamp", "floor-lamp", "floor_lamp" -> "floor_lamp").
+
+    Every label comparison in the core (memory, exploration, reasoning) goes through this one
+    rule, so that a label the detector wrote and a word the decomposition read meet. Synonyms
+    ("couch" -> "sofa") are the detector's business (``hiconav.perception.detector.normalise_label``),
+    not the comparison's. Memoised: called for every object on every scoring pass.
+    """
+    return "_".join(label.strip().lower().replace("-", " ").replace("_", " ").split())
 
 
 def wrap_angle(angle: float) -> float:

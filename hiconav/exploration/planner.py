@@ -30,12 +30,12 @@ from hiconav.exploration.config import ExplorationConfig
 from hiconav.exploration.cost import CostMatrix, GridLike, cost_matrix
 from hiconav.exploration.utility import AnchorLike, ObjectLike, frontier_utility, utility_weights
 from hiconav.exploration.wtrp import AUTO_EXACT_MAX_N, solve_wtrp, wtrp_cost
-from hiconav.types import Frontier, Goal, Pose2D, TaskSpec
+from hiconav.types import Frontier, Goal, Pose2D, TaskSpec, label_key
 
 
 def _exact_label_match(label: str, target: str) -> float:
     """FALLBACK similarity when no embedder is given: 1.0 for the same label, else 0.0."""
-    return float(label.strip().lower().replace(" ", "_") == target.strip().lower().replace(" ", "_"))
+    return float(label_key(label) == label_key(target))
 
 
 class SnapshotLike(Protocol):

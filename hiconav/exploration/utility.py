@@ -33,7 +33,7 @@ from typing import Protocol
 import numpy as np
 
 from hiconav.exploration.config import UtilityConfig
-from hiconav.types import TaskSpec
+from hiconav.types import TaskSpec, label_key
 
 Similarity = Callable[[str, str], float]
 
@@ -58,10 +58,6 @@ class AnchorLike(Protocol):
     def intrinsics(self): ...  # CameraIntrinsics (hfov)
 
 
-def _norm_label(label: str) -> str:
-    return label.strip().lower().replace(" ", "_").replace("-", "_")
-
-
 class LabelScorer:
     """Memoised task similarity of labels: max over the task's targets of similarity(label, t).
 
@@ -70,14 +66,14 @@ class LabelScorer:
 
     def __init__(self, task: TaskSpec, similarity: Similarity) -> None:
         self.targets = tuple(task.targets)
-        self._target_norm = {_norm_label(t) for t in task.targets}
-        self.related = {_norm_label(r) for r in task.related}
+        self._target_norm = {label_key(t) for t in task.targets}
+        self.related = {label_key(r) for r in task.related}
         self._similarity = similarity
         self._cache: dict[str, float] = {}
 
     def __call__(self, label: str) -> float:
         if label not in self._cache:
-            if _norm_label(label) in self._target_norm:
+            if label_key(label) in self._target_norm:
                 value = 1.0
             elif not self.targets:
                 value = 0.0
@@ -87,7 +83,7 @@ class LabelScorer:
         return self._cache[label]
 
     def is_related(self, label: str) -> bool:
-        return _norm_label(label) in self.related
+        return label_key(label) in self.related
 
 
 def object_sigmas(box_min: np.ndarray, box_max: np.ndarray, config: UtilityConfig) -> np.ndarray:

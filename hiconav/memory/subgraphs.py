@@ -22,7 +22,6 @@ Pure function of a snapshot: must not modify the graph or call a VLM.
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -30,7 +29,7 @@ import numpy as np
 
 from hiconav.geometry import footprint_gap
 from hiconav.memory.snapshot import AnchorView, MemorySnapshot, ObjectView
-from hiconav.types import TaskSpec
+from hiconav.types import TaskSpec, label_key
 
 __all__ = ["Subgraph", "decompose", "task_similarity"]
 
@@ -64,12 +63,6 @@ class Subgraph:
         return tuple(o.id for o in self.objects)
 
 
-@functools.lru_cache(maxsize=4096)
-def _norm(label: str) -> str:
-    # memoised: called for every object and task word on every decomposition
-    return "_".join(label.strip().lower().replace("-", " ").split())
-
-
 def task_similarity(label: str, task: TaskSpec, similarity: Callable[[str, str], float],
                     cache: dict[str, float] | None = None) -> float:
     """s(o, T): max(0, similarity of the label to each target and to the instruction)."""
@@ -87,9 +80,9 @@ def task_similarity(label: str, task: TaskSpec, similarity: Callable[[str, str],
 
 def _matches(label: str, words: tuple[str, ...], similarity: Callable[[str, str], float],
              threshold: float) -> bool:
-    key = _norm(label)
+    key = label_key(label)
     for w in words:
-        if key == _norm(w):
+        if key == label_key(w):
             return True
         if threshold < 1.0 and float(similarity(label.replace("_", " "), w.replace("_", " "))) >= threshold:
             return True
@@ -109,8 +102,8 @@ def _context(snapshot: MemorySnapshot, focus: ObjectView, shown: tuple[ObjectVie
 
 def _described(task: TaskSpec) -> bool:
     """The task singles out one instance by relations whose subject is one of its targets."""
-    targets = {_norm(t) for t in task.targets}
-    return any(len(r) >= 3 and _norm(str(r[0])) in targets for r in task.relations)
+    targets = {label_key(t) for t in task.targets}
+    return any(len(r) >= 3 and label_key(str(r[0])) in targets for r in task.relations)
 
 
 def _objects_of(snapshot: MemorySnapshot, anchors: tuple[AnchorView, ...]) -> tuple[ObjectView, ...]:
@@ -143,7 +136,7 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
         total = sum(s_obj(o) for o in objects)  # eq. (11)
         if far_evidence_weight > 0:
             mapped = {o.label for o in objects}
-            far = {_norm(lab) for a in anchors for lab in a.labels_seen} - mapped
+            far = {label_key(lab) for a in anchors for lab in a.labels_seen} - mapped
             total += far_evidence_weight * sum(task_similarity(lab, task, similarity, cache)
                                                for lab in sorted(far))
         return float(total)

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from typing import Protocol, runtime_checkable
 
 from hiconav.registry import Registry
-from hiconav.types import Detection, Frame
+from hiconav.types import Detection, Frame, label_key
 
 __all__ = ["DETECTORS", "Detector", "normalise_label"]
 
@@ -49,5 +49,5 @@ _ALIASES = {
 
 def normalise_label(label: str) -> str:
     """Lowercase snake case with the usual synonyms folded ("Couch" -> "sofa", "TV" -> "tv")."""
-    key = "_".join(label.strip().lower().replace("-", " ").split())
+    key = label_key(label)
     return _ALIASES.get(key, key)

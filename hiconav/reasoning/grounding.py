@@ -34,6 +34,7 @@ import numpy as np
 
 from hiconav.geometry import footprint_gap
 from hiconav.relations import NEAR, NEXT_TO
+from hiconav.types import label_key
 
 # the gaps of the ground-truth predicates that generate described-instance episodes
 # (``hiconav.relations``), so that a description and its grounding mean one thing, plus the
@@ -96,7 +97,7 @@ class BoxLike(Protocol):
 
 def room_of(label: str) -> str | None:
     """The room type a relation's object names ("living room" -> "living_room"), or None."""
-    key = label.strip().lower().replace(" ", "_").replace("-", "_")
+    key = label_key(label)
     return ROOM_ALIASES.get(key)
 
 
@@ -145,12 +146,12 @@ def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = ()) -> dict[
     description tells apart, so a tv's own "living room" cue must not decide which room it is in."""
     out: dict[int, tuple[str | None, float]] = {}
     anchors = {o.id: set(getattr(o, "anchor_ids", ()) or ()) for o in objects}
-    skip = {str(t).strip().lower().replace(" ", "_") for t in ignore}
+    skip = {label_key(str(t)) for t in ignore}
     for o in objects:
         scores: dict[str, float] = {}
         for other in objects:
             cues = ROOM_CUES.get(other.label)
-            if not cues or other.label.strip().lower().replace(" ", "_") in skip:
+            if not cues or label_key(other.label) in skip:
                 continue
             if other.id != o.id and not (anchors[o.id] & anchors[other.id]):
                 continue
@@ -181,13 +182,13 @@ class Grounding:
 
 def labels_match(label: str, name: str) -> bool:
     """True when two labels name one thing (case, spaces and underscores aside)."""
-    return label.strip().lower().replace(" ", "_") == name.strip().lower().replace(" ", "_")
+    return label_key(label) == label_key(name)
 
 
 def target_relations(relations: Iterable[Sequence[str]], targets: Iterable[str]) -> list[tuple[str, str, str]]:
     """The relations whose subject is one of ``targets``: what singles out the described instance."""
-    names = {t.strip().lower().replace(" ", "_") for t in targets}
-    return [(s, r, o) for s, r, o in (tuple(x) for x in relations) if s.strip().lower().replace(" ", "_") in names]
+    names = {label_key(t) for t in targets}
+    return [(s, r, o) for s, r, o in (tuple(x) for x in relations) if label_key(s) in names]
 
 
 def ground(candidate: BoxLike, objects: Sequence[BoxLike], relations: Sequence[Sequence[str]],

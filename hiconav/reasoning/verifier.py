@@ -29,7 +29,7 @@ from hiconav.reasoning.config import ReasoningConfig
 from hiconav.reasoning.hypothesis import TargetHypothesis
 from hiconav.reasoning.prompts import ViewIndex, verification_messages
 from hiconav.registry import Registry
-from hiconav.types import TaskSpec
+from hiconav.types import TaskSpec, label_key
 
 log = logging.getLogger(__name__)
 
@@ -219,9 +219,9 @@ class OfflineVerifier:
 
     def _match(self, label: str, targets: Sequence[str]) -> tuple[float, str]:
         best, best_t = 0.0, ""
-        norm = label.strip().lower().replace(" ", "_")
+        norm = label_key(label)
         for t in targets:
-            if norm == t.strip().lower().replace(" ", "_"):
+            if norm == label_key(t):
                 return 1.0, t
             if self.similarity is not None:
                 s = float(self.similarity(norm.replace("_", " "), t.replace("_", " ")))
