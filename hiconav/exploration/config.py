@@ -24,6 +24,10 @@ class UtilityConfig(BaseModel):
     lambda2: float = Field(1.0, ge=0.0, description="weight of S_vis (eq. 9)")
     gamma: float = Field(1.5, ge=1.0, description="semantic gain of related objects O_r (eq. 11)")
     beta: float = Field(3.0, ge=0.0, description="temperature of W = exp(beta S_bar) / exp(beta) (eq. 16)")
+    weight_min_range: float = Field(0.1, ge=0.0, description="eq. 16's min-max normalisation divides by "
+                                    "max(S_max - S_min, this): frontiers whose utilities differ by less "
+                                    "weigh nearly alike, and travel time orders them (0: the paper's plain "
+                                    "min-max)")
     sigma_scale: float = Field(1.0, gt=0.0, description="sigma_j = sigma_scale * mean 3D box extent (m)")
     sigma_min: float = Field(0.5, gt=0.0, description="lower clip of sigma_j (m): tiny boxes still "
                              "spread context over a room part")

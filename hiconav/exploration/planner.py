@@ -150,7 +150,7 @@ class ExplorationPlanner:
                                    seconds=time.perf_counter() - t0)
         centroids = np.array([np.asarray(f.centroid, float)[:2] for f in frontiers])
         S, s_struct, s_vis = frontier_utility(centroids, objects, anchors, task, similarity, ucfg)
-        W_all = utility_weights(S, ucfg.beta)  # eq. 16
+        W_all = utility_weights(S, ucfg.beta, ucfg.weight_min_range)  # eq. 16
         weights = {i: float(w) for i, w in zip(ids, W_all)}
         utilities = {i: float(s) for i, s in zip(ids, S)}
         extra = {"s_struct": {i: float(v) for i, v in zip(ids, s_struct)},

@@ -194,13 +194,19 @@ def frontier_utility(points_xy: np.ndarray, objects: Sequence[ObjectLike], ancho
     return cfg.lambda1 * s_struct + cfg.lambda2 * s_vis, s_struct, s_vis  # eq. 9
 
 
-def utility_weights(S: np.ndarray, beta: float) -> np.ndarray:
-    """W = exp(beta * minmax(S)) / exp(beta) (eq. 16), in (0, 1]; all-equal S gives W = 1."""
+def utility_weights(S: np.ndarray, beta: float, min_range: float = 0.0) -> np.ndarray:
+    """W = exp(beta * S_bar) / exp(beta) (eq. 16), S_bar = (S - S_min) / max(S_max - S_min,
+    ``min_range``); W in (0, 1], the best frontier's 1; all-equal S gives W = 1.
+
+    The plain min-max (``min_range`` 0) stretches any spread to [0, 1]: utilities 0.02 apart
+    weigh 1 and exp(-beta) as surely as ones 1.0 apart. With a floor, a spread below it is
+    treated as the evidence's noise: the weights stay near 1 and travel time orders the
+    frontiers."""
     S = np.asarray(S, dtype=float)
     if S.size == 0:
         return S.copy()
     lo, hi = float(S.min()), float(S.max())
     if hi - lo <= 1e-12 * max(1.0, abs(hi)):
         return np.ones_like(S)
-    s_bar = (S - lo) / (hi - lo)
-    return np.exp(beta * (s_bar - 1.0))  # = exp(beta s_bar) / exp(beta), without overflow
+    s_bar = (S - lo) / max(hi - lo, float(min_range))
+    return np.exp(beta * (s_bar - float(s_bar.max())))  # = exp(beta s_bar) / exp(beta max), no overflow

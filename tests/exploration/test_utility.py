@@ -118,6 +118,34 @@ def test_weights_in_unit_interval_and_monotone() -> None:
     assert utility_weights(np.array([0.0, 1.0]), beta=5.0)[0] < utility_weights(np.array([0.0, 1.0]), beta=1.0)[0]
 
 
+def test_weight_floor_keeps_small_utility_spreads_from_ordering_the_frontiers() -> None:
+    """eq. 16 with ``min_range``: a spread below the floor is the evidence's noise, so the weights
+    stay near 1 (travel time orders the frontiers); a spread above it is stretched as before."""
+    small = np.array([0.50, 0.51, 0.52])
+    plain = utility_weights(small, beta=3.0)
+    assert plain.min() == pytest.approx(math.exp(-3.0))  # 0.02 apart: weights 0.05 .. 1
+    floored = utility_weights(small, beta=3.0, min_range=0.1)
+    assert floored.max() == pytest.approx(1.0)
+    assert floored.min() == pytest.approx(math.exp(-3.0 * 0.02 / 0.1))  # 0.55: nearly alike
+    assert np.all(np.diff(floored) > 0)  # the order by utility is kept
+    wide = np.array([0.0, 0.3, 0.6])
+    assert utility_weights(wide, beta=3.0, min_range=0.1) == pytest.approx(utility_weights(wide, beta=3.0))
+    assert utility_weights(np.full(4, 0.2), beta=3.0, min_range=0.1).tolist() == [1.0] * 4
+
+
+def test_weight_floor_turns_the_wtrp_order_to_travel_time() -> None:
+    """Two frontiers with near-equal utility: without the floor the WTRP visits the slightly
+    better far one first; with it the near one (less travel, the same expected find)."""
+    from hiconav.exploration.wtrp import solve_wtrp
+
+    travel = np.array([[0.0, 2.0, 10.0], [2.0, 0.0, 9.0], [10.0, 9.0, 0.0]])  # 0: robot, 1: near, 2: far
+    S = np.array([0.50, 0.52])
+    for floor, first in ((0.0, 2), (0.1, 1)):
+        W = utility_weights(S, beta=3.0, min_range=floor)
+        order = list(solve_wtrp(travel, W, method="exact").order)
+        assert order[0] == first, (floor, order)
+
+
 def test_similarity_floor_removes_the_embedder_baseline() -> None:
     """s_j = max(0, similarity - floor): a weakly related object adds nothing, a related one
     keeps its excess; the anchor score (S_vis) uses the same floor."""
