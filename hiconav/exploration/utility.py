@@ -195,8 +195,9 @@ def frontier_utility(points_xy: np.ndarray, objects: Sequence[ObjectLike], ancho
 
 
 def utility_weights(S: np.ndarray, beta: float, min_range: float = 0.0) -> np.ndarray:
-    """W = exp(beta * S_bar) / exp(beta) (eq. 16), S_bar = (S - S_min) / max(S_max - S_min,
-    ``min_range``); W in (0, 1], the best frontier's 1; all-equal S gives W = 1.
+    """W = exp(beta * S_bar) / exp(beta * max S_bar) (eq. 16), S_bar = (S - S_min) / max(S_max -
+    S_min, ``min_range``): with the plain min-max max S_bar = 1, the paper's / exp(beta). W in
+    (0, 1], the best frontier's 1; all-equal S gives W = 1.
 
     The plain min-max (``min_range`` 0) stretches any spread to [0, 1]: utilities 0.02 apart
     weigh 1 and exp(-beta) as surely as ones 1.0 apart. With a floor, a spread below it is
