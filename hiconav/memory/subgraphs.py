@@ -135,7 +135,7 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
     def score(anchors: tuple[AnchorView, ...], objects: tuple[ObjectView, ...]) -> float:
         total = sum(s_obj(o) for o in objects)  # eq. (11)
         if far_evidence_weight > 0:
-            mapped = {o.label for o in objects}
+            mapped = {label_key(o.label) for o in objects}
             far = {label_key(lab) for a in anchors for lab in a.labels_seen} - mapped
             total += far_evidence_weight * sum(task_similarity(lab, task, similarity, cache)
                                                for lab in sorted(far))
