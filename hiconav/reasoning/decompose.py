@@ -70,7 +70,7 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("tv", "television", "tv set", "television set", "telly", "flat screen", "flatscreen tv",
      "flat screen tv", "tv screen", "television screen", "smart tv"): ("tv", "television"),
     ("plant", "potted plant", "house plant", "houseplant", "pot plant", "indoor plant",
-     "flower pot", "flowerpot", "planter", "flowers", "flower"): ("plant", "potted_plant", "house_plant"),
+     "flower pot", "flowerpot", "plant pot", "planter", "flowers", "flower"): ("plant", "potted_plant", "house_plant"),
     ("fridge", "refrigerator", "freezer", "icebox"): ("fridge", "refrigerator"),
     ("dining table", "dinner table", "kitchen table", "dining-table", "table", "eating table"):
         ("table", "dining_table"),
@@ -86,7 +86,7 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("toilet", "wc", "commode", "loo", "water closet", "toilet bowl", "lavatory"): ("toilet",),
     ("sink", "washbasin", "wash basin", "basin", "kitchen sink", "bathroom sink", "handbasin"):
         ("sink",),
-    ("bathtub", "bath tub", "tub", "bath"): ("bathtub",),
+    ("bathtub", "bath tub", "tub", "bath", "jacuzzi", "hot tub"): ("bathtub",),
     ("shower", "shower stall", "shower cabin"): ("shower",),
     ("garbage can", "trash can", "trashcan", "bin", "trash bin", "garbage bin", "wastebasket",
      "waste basket", "dustbin", "rubbish bin", "waste bin"): ("garbage_can",),
@@ -103,12 +103,12 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("coffee machine", "coffee maker", "espresso machine", "coffeemaker"): ("coffee_machine",),
     ("washing machine", "washer", "laundry machine"): ("washing_machine",),
     ("clothes dryer", "dryer", "tumble dryer"): ("clothes_dryer",),
-    ("dresser", "chest of drawers", "drawers", "chest", "wardrobe", "closet"): ("dresser",),
+    ("dresser", "chest of drawers", "drawers", "chest", "wardrobe", "closet", "bureau"): ("dresser",),
     ("alarm clock",): ("alarm_clock", "clock"),
     ("clock", "wall clock"): ("clock",),
     ("teddy bear", "teddy", "stuffed animal", "plush toy", "soft toy"): ("teddy_bear",),
     ("stool", "bar stool", "step stool"): ("stool",),
-    ("ottoman", "pouf", "footstool", "foot stool", "footrest"): ("ottoman", "footstool"),
+    ("ottoman", "pouf", "pouffe", "footstool", "foot stool", "footrest"): ("ottoman", "footstool"),
     ("oven", "cooker", "range"): ("oven", "stove"),
     ("stove", "stovetop", "hob", "cooktop", "stove burner"): ("stove", "oven"),
     ("microwave", "microwave oven"): ("microwave",),
@@ -123,7 +123,8 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("towel", "bath towel"): ("towel",),
     ("hand towel",): ("hand_towel", "towel"),
     ("tv stand", "tv cabinet", "media console", "entertainment center", "tv unit",
-     "television stand"): ("tv_stand",),
+     "television stand", "tv console", "tv bench", "tv table", "entertainment unit", "media unit",
+     "entertainment centre"): ("tv_stand",),
     ("garbage bag", "trash bag", "bin bag"): ("garbage_bag",),
     ("laundry hamper", "laundry basket", "hamper", "clothes basket"): ("laundry_hamper",),
     ("toilet paper", "toilet roll", "loo roll", "bathroom tissue"): ("toilet_paper",),
@@ -265,7 +266,8 @@ DETERMINERS = frozenset([
 # Leading phrases to strip (longest first), repeated until none applies.
 IMPERATIVES: tuple[str, ...] = tuple(sorted("""
 please|can you|could you|would you|will you|i want you to|i need you to|i'd like you to|
-i would like you to|you should|try to|help me|let's|let us|now|then|and|first|
+i would like you to|i'd like to go to|i would like to go to|i'd like to get to|i'd like to|
+i would like to|you should|try to|help me|let's|let us|now|then|and|first|
 find|find me|locate|look for|search for|search|seek|spot|detect|identify|look at|
 go to|go find|go and find|go towards|go toward|go near|go over to|go|navigate to|navigate towards|
 navigate|move to|move towards|walk to|walk towards|walk over to|head to|head towards|head for|
@@ -292,19 +294,29 @@ RELATIONS: dict[str, str] = {
     "among": "between", "with": "with", "against": "against", "opposite": "opposite",
     "opposite to": "opposite", "across from": "opposite", "facing": "facing",
     "around": "near", "from": "near",
+    # "the desk that has a lamp on it": what it carries is near it (its own relation, "on it",
+    # follows and is parsed on the carried object)
+    "has": "with", "have": "with", "having": "with", "holding": "with", "holds": "with",
 }
 _RELATION_KEYS = sorted(RELATIONS, key=lambda p: -len(p.split()))
+# nouns for a part of a room or of a house, never an object: "in the corner", "at the far end"
+PLACE_NOUNS = frozenset(["corner", "room", "side", "end", "middle", "center", "centre", "area", "space",
+                         "part", "place", "spot", "floor", "wall", "back", "front", "edge", "house",
+                         "home", "left", "right"])
+# the relations that place an object in a room ("in the kitchen", "at the far end of the hallway")
+CONTAINMENT = frozenset(["in", "at", "inside", "within"])
 # Filler between a noun and its relation ("the mug that is on the table").
 FILLERS = frozenset([
     "that", "which", "who", "is", "are", "was", "sits", "sit", "sitting", "located", "placed",
     "standing", "stands", "lying", "lies", "positioned", "found", "kept", "hung", "hanging", "set",
     "resting", "rests", "there", "it's", "its", "just", "right", "directly", "somewhere", "usually",
-    "probably",
+    "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
+    "displayed", "installed", "be", "should", "must",
 ])
 PRONOUNS = frozenset([
     "it", "its", "it's", "itself", "they", "them", "this", "that", "which", "one", "ones",
 ])
-_IRREGULAR_PLURALS = {"knives": "knife", "shelves": "shelves", "leaves": "leaf", "glasses": "glass",
+_IRREGULAR_PLURALS = {"knives": "knife", "shelves": "shelves", "bookshelves": "bookshelf", "leaves": "leaf", "glasses": "glass",
                       "mice": "mouse", "people": "person", "feet": "foot", "dishes": "dish",
                       "boxes": "box", "benches": "bench", "couches": "couch", "watches": "watch",
                       "brushes": "brush", "glass": "glass", "tv": "tv", "bus": "bus"}
@@ -322,6 +334,19 @@ def _singular(word: str) -> str:
     if word.endswith("s"):
         return word[:-1]
     return word
+
+
+def _room_modifier(words: Sequence[str]) -> tuple[list[str], str | None]:
+    """Split a noun's modifiers into (the other modifiers, the room they name or None): "the
+    bedroom TV", "the living room sofa". A name that holds a room word ("kitchen sink") is a
+    lexicon phrase and never reaches here."""
+    words = list(words)
+    for n in (3, 2, 1):
+        for i in range(len(words) - n + 1):
+            phrase = " ".join(words[i:i + n])
+            if phrase in ROOMS:
+                return words[:i] + words[i + n:], ROOMS[phrase]
+    return words, None
 
 
 def _spaced(label: str) -> str:
@@ -372,7 +397,8 @@ class NounPhrase:
     attributes: tuple[str, ...]
     text: str
     in_vocabulary: bool
-    room: str | None = None
+    room: str | None = None  # the phrase names a room ("the kitchen")
+    in_room: str | None = None  # a room word qualifies the object ("the bedroom TV")
 
 
 class OfflineParser:
@@ -449,8 +475,20 @@ class OfflineParser:
                     continue
                 phrases = self._noun_phrases(np_words)
                 for p in phrases:
+                    if p.room and relation not in CONTAINMENT:
+                        # "the toilet in the bathroom next to the bedroom": where a room lies is
+                        # not a relation of the object, and names no room it is in
+                        log.info("relation %r to the room %r not kept: not a containment", relation, p.room)
+                        continue
+                    if not p.room and p.label in PLACE_NOUNS:
+                        # "the plant in the corner": a part of a room, no object a detector
+                        # maps, so nothing the relation could be checked on; kept, it would
+                        # hold the search for ever
+                        log.info("relation %r to %r not kept: a place, not an object", relation, p.text)
+                        continue
                     for subj in previous[:1]:
-                        relations.append((subj.label, relation, p.room or p.label))
+                        if subj.label not in PLACE_NOUNS or subj in targets:
+                            relations.append((subj.label, relation, p.room or p.label))
                     if p.room:
                         rooms.append(p.room)
                     else:
@@ -466,6 +504,11 @@ class OfflineParser:
         if not targets:
             raise InstructionError(f"no object found in the instruction {instruction!r}",
                                    field="instruction")
+        # a room word before the noun: "the bedroom TV" is the TV in the bedroom
+        rooms += [p.in_room for p in targets[:1] if p.in_room]
+        for p in related:
+            if p.in_room and (p.label, "in", p.in_room) not in relations:
+                relations.append((p.label, "in", p.in_room))
         target_labels = list(dict.fromkeys(p.label for p in targets))
         for room in dict.fromkeys(rooms):
             rel = (target_labels[0], "in", room)
@@ -538,6 +581,9 @@ class OfflineParser:
     def _refers_to_target(self, words: list[str], targets: list[NounPhrase]) -> bool:
         if words and words[0] in ("it", "it's", "its", "this", "which"):
             return True
+        # "Find the TV. The one in the bedroom."
+        if words[:1] == ["one"] or words[:2] in (["the", "one"], ["that", "one"]):
+            return True
         text = " " + " ".join(words) + " "
         for t in targets:
             name = _spaced(t.label)
@@ -603,6 +649,10 @@ class OfflineParser:
         # "a bottle of wine" -> "bottle" (the head comes before "of"), unless "of" is in a name.
         if "of" in words:
             k = words.index("of")
+            after = " ".join(words[k + 1:])
+            if after in ROOMS and " ".join(words) not in self.lexicon.phrases:
+                # "the corner of the living room", "the far side of the kitchen": the room
+                return NounPhrase(ROOMS[after], (), " ".join(words), False, room=ROOMS[after])
             if " ".join(words) not in self.lexicon.phrases and k > 0:
                 words = words[:k]
         if not words:
@@ -624,8 +674,8 @@ class OfflineParser:
         for n in range(min(self.lexicon.max_words, len(rest)), 0, -1):
             hit = self.lexicon.lookup(" ".join(rest[-n:]))
             if hit is not None:
-                modifiers = [w for w in rest[:-n] if w not in ROOMS]
-                return NounPhrase(hit, tuple(attrs + modifiers), text, True)
+                modifiers, in_room = _room_modifier(rest[:-n])
+                return NounPhrase(hit, tuple(attrs + modifiers), text, True, in_room=in_room)
         # Attribute words that also name objects ("light") were removed; try the whole text.
         hit = self.lexicon.lookup(text)
         if hit is not None:

@@ -83,6 +83,10 @@ ROOM_CUES: dict[str, tuple[tuple[str, float], ...]] = {
     "tv": (("living_room", 1.5),), "armchair": (("living_room", 1.5),), "floor_lamp": (("living_room", 0.7),),
     "ottoman": (("living_room", 1.0),), "dining_table": (("living_room", 0.5), ("kitchen", 0.5)),
 }
+# room types the instruction parser knows (hiconav.reasoning.decompose.ROOMS) that no room cue
+# infers: the ProcTHOR houses have none of them, and the objects that furnish them (a dining
+# table, a desk, a washing machine) stand in the four rooms above as often
+UNINFERRED_ROOMS = frozenset(["dining_room", "hallway", "office", "laundry_room", "garage"])
 NEAR_WORDS = frozenset(["near", "left of", "right of", "in front of", "behind", "facing", "opposite", "at",
                         "with", "against", "by"])
 
@@ -216,6 +220,10 @@ def ground(candidate: BoxLike, objects: Sequence[BoxLike], relations: Sequence[S
 def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relations: Sequence[Sequence[str]],
          rooms: dict[int, tuple[str | None, float]], depth: int) -> tuple[str, str]:
     room = room_of(obj)
+    if room is None and label_key(obj) in UNINFERRED_ROOMS:
+        # "the table in the dining room": a room type no cue of ROOM_CUES tells apart; waiting
+        # for its evidence would hold the search forever, so the words are not checked
+        return "holds", f"a {obj.replace('_', ' ')} is no room type the map infers (not checked)"
     if room is not None and rel.strip().lower() in ("in", "at", "inside", "within"):
         seen, score = rooms.get(node.id, (None, 0.0))
         if seen is None:

@@ -71,7 +71,33 @@ CASES: list[tuple[str, tuple, tuple, dict, tuple]] = [
     ("Find the microwave. It sits above the stove, to the right of the fridge.", ("microwave",),
      ("stove", "fridge"), {}, (("microwave", "above", "stove"), ("microwave", "right of", "fridge"))),
     ("Find the cup. There is a plate next to it.", ("cup",), ("plate",), {}, (("plate", "next to", "cup"),)),
+    # people's phrasings: a follow-up naming "the one", a room word before the noun, what the
+    # target carries, participles between the noun and its relation
+    ("Where's the TV? The one in the bedroom.", ("tv",), (), {}, (("tv", "in", "bedroom"),)),
+    ("the bedroom TV", ("tv",), (), {}, (("tv", "in", "bedroom"),)),
+    ("go to the living room sofa", ("sofa",), (), {}, (("sofa", "in", "living_room"),)),
+    ("the desk that has a lamp on it", ("desk",), ("floor_lamp",), {}, (("desk", "with", "floor_lamp"),)),
+    ("find the tv that is mounted above the tv stand", ("tv",), ("tv_stand",), {}, (("tv", "above", "tv_stand"),)),
+    ("navigate to the plant in the corner of the living room", ("plant",), (), {},
+     (("plant", "in", "living_room"),)),
+    ("I'd like to go to the fridge in the kitchen", ("fridge",), (), {}, (("fridge", "in", "kitchen"),)),
 ]
+
+
+@pytest.mark.parametrize("instruction,relations", [
+    # a place inside a room is no object to check a relation on
+    ("find the plant in the corner", ()),
+    ("find the bed in the room with the desk", ()),
+    # a room's own position is not the target's relation, nor its room
+    ("go to the toilet in the bathroom next to the bedroom", (("toilet", "in", "bathroom"),)),
+    # a room word inside a name ("kitchen table", "bathroom sink") is part of the name
+    ("find the kitchen table", ()),
+    ("find the bathroom sink", ()),
+])
+def test_relations_are_kept_only_when_they_can_be_checked(parser, instruction, relations) -> None:
+    task = parser.parse(instruction)
+    assert task.relations == relations, task.relations
+    assert not task.attributes, task.attributes
 
 
 @pytest.fixture(scope="module")
@@ -216,3 +242,11 @@ def test_minilm_maps_unknown_nouns_and_keeps_unrelated_ones() -> None:
     assert p.parse("find the refrigerator unit").targets == ("fridge",)  # similarity ~0.78
     assert p.parse("find the teapot").targets == ("kettle",)  # ~0.63
     assert p.parse("go to the fireplace").targets == ("fireplace",)  # nearest is stove at ~0.59: kept
+
+
+@pytest.mark.parametrize("name,label", [
+    ("bureau", "dresser"), ("bookshelves", "shelving_unit"), ("tv console", "tv_stand"),
+    ("entertainment unit", "tv_stand"), ("pouffe", "ottoman"), ("jacuzzi", "bathtub"), ("plant pot", "plant"),
+])
+def test_household_names_people_use_map_to_the_category(parser, name, label) -> None:
+    assert parser.parse(f"find the {name}").targets == (label,)

@@ -139,6 +139,18 @@ def test_a_relation_to_an_object_not_yet_seen_is_unknown_not_a_failure():
     assert verdict.status == "unknown"
 
 
+def test_a_room_type_the_map_cannot_infer_is_not_waited_for():
+    # no cue tells a dining room or an office from the four room types the map infers: waiting
+    # for one would hold the search for ever, so the words are not checked
+    objects = [node(1, "dining_table", (0, 0), (1.5, 0.9)), node(2, "chair", (0.9, 0), (0.4, 0.4))]
+    verdict = ground(objects[0], objects, (("dining_table", "in", "dining_room"),), ("dining_table",))
+    assert verdict.status == "holds" and "not checked" in verdict.evidence[0]
+    nested = (("chair", "next to", "dining_table"), ("dining_table", "in", "dining_room"))
+    assert ground(objects[1], objects, nested, ("chair",)).status == "holds"
+    # a room it does infer still needs its cues
+    assert ground(objects[0], objects, (("dining_table", "in", "bedroom"),), ("dining_table",)).status == "unknown"
+
+
 def test_a_related_object_must_satisfy_its_own_relations():
     # the lamp beside the armchair stands in a bedroom: "the floor lamp in the living room" fails
     objects = [node(1, "armchair", (0, 0)), node(2, "floor_lamp", (0.9, 0), (0.3, 0.3)),
