@@ -1,0 +1,129 @@
+"""People's phrasings of described instances: does the offline parser read them as the template?
+
+The episode generator (``hiconav episodes --task textnav``) writes instructions from a few
+templates ("take me to the chair next to the fridge"). People say the same thing in other ways:
+a room word before the noun ("the kitchen table"), a follow-up sentence ("Find the chair. The one
+next to the fridge."), a relative clause ("the chair that is next to the fridge"), a polite
+lead ("I'd like to go to ..."). A parser that reads only the templates loses the description and
+stops at the first instance of the category it sees.
+
+For each textnav instruction the script writes every form below that applies, decomposes the
+template and each form offline (``decompose_instruction``, MiniLM similarity) and counts a form as
+read when its targets and relations equal the template's. It prints one line per form, the
+instructions read differently (up to ``--show``), then one JSON line:
+
+    {"instructions": N, "phrasings": P, "agree": A, "rate": A / P, "by_form": {form: rate, ...}}
+
+    python benchmarks/phrasings.py [--episodes FILE.jsonl] [--houses FILE] [--limit 30] [--show 10]
+
+Without ``--episodes`` it generates one textnav episode per house for the first ``--limit``
+houses of ``--houses`` (default: the shared ProcTHOR val houses), about 3 s a house.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from pathlib import Path
+
+from hiconav.reasoning.config import ReasoningConfig
+from hiconav.reasoning.decompose import decompose_instruction
+from hiconav.sim.task_episodes import spoken
+
+LEAD = re.compile(r"^(find|go to|take me to|where is|i'm looking for|navigate to|can you find|please go to) the ",
+                  re.IGNORECASE)
+ROOM = re.compile(r"in the (kitchen|living room|bedroom|bathroom)")
+
+
+def forms(instruction: str, target: str) -> dict[str, str]:
+    """The people's forms of one template instruction (form name -> text); {} when the template's
+    noun phrase cannot be found (the instruction is not a generator template)."""
+    text = instruction.strip().rstrip("?.")
+    m = LEAD.match(text)
+    np_ = text[m.end():] if m else text
+    name = spoken(target)
+    if not np_.lower().startswith(name.lower()):
+        return {}
+    rest = np_[len(name):].strip()
+    out = {
+        "follow-up": f"Find the {name}. The one {rest}.",
+        "relative clause": f"I'd like to go to the {name} that is {rest}",
+        "question": f"Could you head over to the {name} {rest}?",
+        "bare": f"the {name} {rest}, please",
+    }
+    room = ROOM.fullmatch(rest)
+    if room:
+        out["room word"] = f"take me to the {room.group(1)} {name}"
+    return out
+
+
+def generated(houses: str, limit: int) -> list[dict]:
+    from hiconav.sim.houses import load_house
+    from hiconav.sim.task_episodes import generate_task_episodes
+
+    eps = []
+    for i in range(limit):
+        try:
+            house = load_house(f"{houses}#{i}")
+        except Exception as exc:  # fewer houses than the limit, or a bad line: report and go on
+            print(f"house {houses}#{i}: {exc}", file=sys.stderr)
+            break
+        eps += [{"instruction": e.instruction, "target": e.target}
+                for e in generate_task_episodes(house, i, "textnav", 1, 0)]
+    return eps
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--episodes", help="a textnav episode file (JSON Lines); default: generate")
+    ap.add_argument("--houses", default=str(Path(__file__).resolve().parents[1].parent / "shared" / "data"
+                                            / "procthor" / "val.jsonl.gz"))
+    ap.add_argument("--limit", type=int, default=30, help="houses to generate episodes in")
+    ap.add_argument("--show", type=int, default=10, help="phrasings read differently to print")
+    args = ap.parse_args(argv)
+    if args.episodes:
+        eps = [json.loads(line) for line in open(args.episodes) if line.strip()]
+    else:
+        eps = generated(args.houses, args.limit)
+    from hiconav.perception.embedder import get_embedder
+
+    similarity = get_embedder("minilm").similarity
+    cfg = ReasoningConfig()
+
+    def key(text: str):
+        t = decompose_instruction(text, cfg, similarity=similarity)
+        return t.targets, frozenset(t.relations)
+
+    total = agree = 0
+    by_form: dict[str, list[int]] = {}
+    wrong: list[tuple[str, str]] = []
+    n = 0
+    for ep in eps:
+        fs = forms(ep["instruction"], ep["target"])
+        if not fs:
+            continue
+        n += 1
+        want = key(ep["instruction"])
+        for form, text in fs.items():
+            ok = key(text) == want
+            total += 1
+            agree += ok
+            by_form.setdefault(form, [0, 0])
+            by_form[form][0] += ok
+            by_form[form][1] += 1
+            if not ok:
+                wrong.append((ep["instruction"], text))
+    for form, (a, t) in sorted(by_form.items()):
+        print(f"{form:16s} {a:4d}/{t:<4d} read as the template")
+    for template, text in wrong[:args.show]:
+        print(f"  differs: {text!r} (template {template!r})")
+    print(json.dumps({"instructions": n, "phrasings": total, "agree": agree,
+                      "rate": round(agree / total, 4) if total else None,
+                      "by_form": {f: round(a / t, 4) for f, (a, t) in sorted(by_form.items())}}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
