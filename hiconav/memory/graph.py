@@ -243,6 +243,7 @@ class CognitiveMemoryGraph:
                     updated.append(j)
                 node = self.objects[j]
                 node.anchor_ids.add(anchor.id)  # bipartite edge (a_i, o_j)
+                node.observed_by.add(anchor.id)
                 node.touch()
                 anchor.add_box(j, obs.box_norm)
                 touched.append(j)

@@ -173,6 +173,9 @@ class ObjectNode:
     embedding: np.ndarray | None = None
     last_seen: float = 0.0
     instance_votes: dict[int, int] = field(default_factory=dict)  # oracle diagnostics only
+    # every anchor that ever observed it, pruned ones too: which objects one image showed
+    # together (co-visibility) outlives the image
+    observed_by: set[int] = field(default_factory=set)
     _feature: np.ndarray | None = None
     _view: ObjectView | None = None
 
@@ -245,6 +248,7 @@ class ObjectNode:
         self.n_obs += other.n_obs
         self.score_sum += other.score_sum
         self.anchor_ids |= other.anchor_ids
+        self.observed_by |= other.observed_by
         for k, v in other.instance_votes.items():
             self.instance_votes[k] = self.instance_votes.get(k, 0) + v
         if other.embedding is not None:
@@ -274,5 +278,6 @@ class ObjectNode:
             self._view = ObjectView(self.id, self.label, self.confidence, freeze(center.copy()),
                                     freeze(self.box_min.copy()), freeze(self.box_max.copy()),
                                     self.n_obs, self.feature, tuple(sorted(self.anchor_ids)),
-                                    self.points, self.last_seen, self.gt_instance)
+                                    self.points, self.last_seen, self.gt_instance,
+                                    tuple(sorted(self.observed_by)))
         return self._view

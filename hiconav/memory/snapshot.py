@@ -49,6 +49,7 @@ class ObjectView:
     points: np.ndarray = field(default_factory=lambda: _EMPTY_PTS, repr=False, compare=False)
     last_seen: float = 0.0
     gt_instance: int | None = None
+    observed_by: tuple[int, ...] = ()  # every anchor that ever observed it, pruned ones included
 
     def __post_init__(self) -> None:
         for name in ("center", "box_min", "box_max", "feature", "points"):

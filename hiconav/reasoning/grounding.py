@@ -149,7 +149,8 @@ def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = ()) -> dict[
     label is in ``ignore`` give no cue: for "the tv in the bedroom" the tvs are what the
     description tells apart, so a tv's own "living room" cue must not decide which room it is in."""
     out: dict[int, tuple[str | None, float]] = {}
-    anchors = {o.id: set(getattr(o, "anchor_ids", ()) or ()) for o in objects}
+    # co-visibility: a common anchor, pruned ones included where the node keeps them (observed_by)
+    anchors = {o.id: set(getattr(o, "observed_by", ()) or getattr(o, "anchor_ids", ()) or ()) for o in objects}
     skip = {label_key(str(t)) for t in ignore}
     for o in objects:
         scores: dict[str, float] = {}

@@ -188,6 +188,8 @@ def test_prune_keeps_min_r_deg_observers_and_drops_edges(embedder):
     snap = g.snapshot()
     assert len(snap.anchors) == 2 and snap.objects[0].anchor_ids == res.kept_anchor_ids
     assert snap.n_edges == 2
+    # which anchors ever observed the node outlives the pruned images (co-visibility for rooms)
+    assert snap.objects[0].observed_by == tuple(range(6))
 
 
 def test_prune_keeps_an_object_seen_once_and_far_evidence(embedder):

@@ -139,6 +139,20 @@ def test_a_relation_to_an_object_not_yet_seen_is_unknown_not_a_failure():
     assert verdict.status == "unknown"
 
 
+@dataclass(frozen=True)
+class ObservedNode(Node):
+    observed_by: tuple[int, ...] = ()
+
+
+def test_a_room_cue_counts_when_the_image_that_showed_both_was_pruned():
+    # the tv and the bed were in one image, since pruned: only observed_by remembers it
+    tv = ObservedNode(1, "tv", np.array([0.0, 0.0, 0.5]), np.array([1.0, 0.2, 1.1]), (7,), observed_by=(3, 7))
+    bed = ObservedNode(2, "bed", np.array([0.0, 1.5, 0.0]), np.array([2.0, 3.5, 0.6]), (9,), observed_by=(3, 9))
+    assert infer_rooms([tv, bed], ignore=("tv",))[1][0] == "bedroom"
+    no_history = [node(1, "tv", (0.5, 0.1), anchors=(7,)), node(2, "bed", (1.0, 2.5), (2.0, 2.0), anchors=(9,))]
+    assert infer_rooms(no_history, ignore=("tv",))[1][0] is None
+
+
 def test_a_room_type_the_map_cannot_infer_is_not_waited_for():
     # no cue tells a dining room or an office from the four room types the map infers: waiting
     # for one would hold the search for ever, so the words are not checked
