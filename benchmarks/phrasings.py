@@ -15,6 +15,11 @@ instructions read differently (up to ``--show``), then one JSON line:
     {"instructions": N, "phrasings": P, "agree": A, "rate": A / P, "by_form": {form: rate, ...}}
 
     python benchmarks/phrasings.py [--episodes FILE.jsonl] [--houses FILE] [--limit 30] [--show 10]
+                                   [--write PEOPLE.jsonl]
+
+``--write`` also writes the episodes (``--episodes`` required) with one form each, for
+``hiconav eval``: even lines the room word where it applies, else the follow-up; odd lines the
+relative clause.
 
 Without ``--episodes`` it generates one textnav episode per house for the first ``--limit``
 houses of ``--houses`` (default: the shared ProcTHOR val houses), about 3 s a house.
@@ -82,7 +87,10 @@ def main(argv: list[str] | None = None) -> int:
                                             / "procthor" / "val.jsonl.gz"))
     ap.add_argument("--limit", type=int, default=30, help="houses to generate episodes in")
     ap.add_argument("--show", type=int, default=10, help="phrasings read differently to print")
+    ap.add_argument("--write", help="write the episodes with one people's form each (needs --episodes)")
     args = ap.parse_args(argv)
+    if args.write and not args.episodes:
+        ap.error("--write needs --episodes")
     if args.episodes:
         eps = [json.loads(line) for line in open(args.episodes) if line.strip()]
     else:
@@ -115,6 +123,15 @@ def main(argv: list[str] | None = None) -> int:
             by_form[form][1] += 1
             if not ok:
                 wrong.append((ep["instruction"], text))
+    if args.write:
+        with open(args.write, "w") as out:
+            for i, ep in enumerate(eps):
+                fs = forms(ep["instruction"], ep["target"])
+                if fs:
+                    even = fs.get("room word", fs["follow-up"])
+                    ep = dict(ep, instruction=even if i % 2 == 0 else fs["relative clause"])
+                out.write(json.dumps(ep) + "\n")
+        print(f"wrote {len(eps)} episodes to {args.write}")
     for form, (a, t) in sorted(by_form.items()):
         print(f"{form:16s} {a:4d}/{t:<4d} read as the template")
     for template, text in wrong[:args.show]:
