@@ -14,8 +14,9 @@ for a subgraph (the VLM path answers the same question from the subgraph's image
   common anchor (co-visible objects share a room far more often than objects behind a wall).
 * **Relations** are predicates on axis-aligned boxes (world metres): ``next to`` a planar gap of
   at most ``NEXT_TO_M``, ``near`` at most ``NEAR_M``, ``on`` resting on the other's top, ``under``
-  and ``above`` overlapping in plan one below the other, ``in`` a room (or inside a box),
-  ``between`` near both. View-dependent words (left of, behind, facing, ...) have no fixed
+  and ``above`` overlapping in plan one below the other, ``facing`` / ``opposite`` at most
+  ``ACROSS_M`` (across a room), ``in`` a room (or inside a box),
+  ``between`` near both. View-dependent words (left of, behind, in front of, ...) have no fixed
   meaning without the speaker's viewpoint and are read as ``near`` (a labelled approximation).
 
 Verdicts are "holds", "fails" or "unknown" (the related object is not in the subgraph, or no room
@@ -45,6 +46,10 @@ from hiconav.types import label_key
 BOX_NOISE_M = 0.1
 NEXT_TO_M = NEXT_TO + BOX_NOISE_M  # m: planar gap between two boxes that reads "next to" / "beside"
 NEAR_M = NEAR + BOX_NOISE_M  # m: planar gap that reads "near"
+# m: planar gap that reads "facing" / "opposite" / "across from": the two stand on either side of
+# a room's open floor (a sofa facing the TV across a living room), farther apart than "near"
+ACROSS_M = 3.5
+ACROSS_WORDS = frozenset(["facing", "opposite", "across from"])
 # m: a box whose bottom lies this close to another's top rests on it (wider than the ground truth's
 # 0.10 m: a memory box grows by a few far-off points of its object)
 ON_GAP_M = 0.30
@@ -137,6 +142,8 @@ def relation_holds(relation: str, a: BoxLike, b: BoxLike) -> bool:
         return _centre_in_plan(a, b, pad=0.0) and float(b.box_min[2]) - 0.1 <= float(a.box_min[2]) <= float(b.box_max[2])
     if rel == "next to":
         return planar_gap(a, b) <= NEXT_TO_M
+    if rel in ACROSS_WORDS:
+        return planar_gap(a, b) <= ACROSS_M
     return planar_gap(a, b) <= NEAR_M  # near and the view-dependent words
 
 

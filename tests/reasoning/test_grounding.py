@@ -153,6 +153,15 @@ def test_a_room_cue_counts_when_the_image_that_showed_both_was_pruned():
     assert infer_rooms(no_history, ignore=("tv",))[1][0] is None
 
 
+def test_facing_reads_across_a_room_farther_than_near():
+    sofa = node(1, "sofa", (0, 0), (2.0, 0.9))
+    tv = node(2, "tv", (0, 3.6), (1.0, 0.2), z=(0.5, 1.1))  # 2.9 m of open floor between them
+    assert relation_holds("facing", sofa, tv) and relation_holds("opposite", sofa, tv)
+    assert not relation_holds("near", sofa, tv)
+    far = node(3, "tv", (0, 5.5), (1.0, 0.2), z=(0.5, 1.1))  # another room's
+    assert not relation_holds("facing", sofa, far)
+
+
 def test_a_room_type_the_map_cannot_infer_is_not_waited_for():
     # no cue tells a dining room or an office from the four room types the map infers: waiting
     # for one would hold the search for ever, so the words are not checked
