@@ -294,15 +294,21 @@ RELATIONS: dict[str, str] = {
     "among": "between", "with": "with", "against": "against", "opposite": "opposite",
     "opposite to": "opposite", "across from": "opposite", "facing": "facing",
     "around": "near", "from": "near",
+    # superlatives ("the chair closest to the fridge") read as near: which of several is the
+    # closest needs every one of them seen, near is what a single view can check
+    "closest to": "near", "nearest to": "near", "nearest the": "near",
     # "the desk that has a lamp on it": what it carries is near it (its own relation, "on it",
     # follows and is parsed on the carried object)
     "has": "with", "have": "with", "having": "with", "holding": "with", "holds": "with",
 }
 _RELATION_KEYS = sorted(RELATIONS, key=lambda p: -len(p.split()))
+# words after which a noun phrase names what is excluded ("in the kitchen, not the bathroom")
+NEGATIONS = ("not", "rather", "instead", "except")
 # nouns for a part of a room or of a house, never an object: "in the corner", "at the far end"
 PLACE_NOUNS = frozenset(["corner", "room", "side", "end", "middle", "center", "centre", "area", "space",
                          "part", "place", "spot", "floor", "wall", "back", "front", "edge", "house",
                          "home", "left", "right"])
+CONTAINER_PLACES = frozenset(["room", "house", "home", "area", "space"])
 # the relations that place an object in a room ("in the kitchen", "at the far end of the hallway")
 CONTAINMENT = frozenset(["in", "at", "inside", "within"])
 # Filler between a noun and its relation ("the mug that is on the table").
@@ -452,6 +458,10 @@ class OfflineParser:
             else:
                 subjects = self._noun_phrases(head_words)
                 if not subjects:
+                    # "In the kitchen, find the chair ...": a room ahead of the object it holds
+                    for relation, np_words in rest:
+                        if relation in CONTAINMENT:
+                            rooms += [p.room for p in self._noun_phrases(np_words) if p.room]
                     continue
                 room_only = [p for p in subjects if p.room]
                 objs = [p for p in subjects if p.room is None]
@@ -464,10 +474,15 @@ class OfflineParser:
                     subjects = targets[:1]
             previous = subjects
             after_comma = bool(head_words) and head_words[-1] == ","
+            negated = any(w in NEGATIONS for w in head_words)
             for relation, np_words in rest:
+                if negated:  # "..., not the one in the bathroom": the rest names what it is not
+                    break
                 if after_comma:  # ", to the right of the fridge": back to the sentence's subject
                     previous = subjects
                 after_comma = bool(np_words) and np_words[-1] == ","
+                # the phrase is parsed up to its negation (``_noun_phrase``); what follows is not
+                negated = any(w in NEGATIONS for w in np_words)
                 if np_words and all(w in PRONOUNS or w == "," for w in np_words):
                     # "... in front of it": "it" is the target
                     if targets and previous and previous[0].label != targets[0].label:
@@ -494,7 +509,11 @@ class OfflineParser:
                     else:
                         related.append(p)
                 if phrases and relation != "between":
-                    objs = [p for p in phrases if p.room is None]
+                    # "the painting on the wall above the sofa": a surface passed over keeps the
+                    # subject; "the bed in the room with the desk": what follows a room-like place
+                    # is said of the place, and dropped with it
+                    objs = [p for p in phrases if p.room is None
+                            and (p.label not in PLACE_NOUNS or p.label in CONTAINER_PLACES)]
                     previous = objs or previous
             for p in subjects + related:
                 if p.attributes:
@@ -551,7 +570,7 @@ class OfflineParser:
     def _sentences(text: str) -> list[str]:
         text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
         text = re.sub(r"[\"“”()\[\]{}:]", " ", text)
-        parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+and\s+(?=(?:find|look|go|search|locate)\b)"
+        parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:find|look|go|search|locate|navigate|take|walk|head)\b)"
                          r"|\s+and\s+(?=(?:find|look for|search for|locate)\b)", text)
         out = []
         for part in parts:
@@ -644,6 +663,10 @@ class OfflineParser:
         return out
 
     def _noun_phrase(self, words: list[str]) -> NounPhrase | None:
+        # "the kitchen, not the bathroom": what is excluded names nothing to look for
+        for stop in NEGATIONS:
+            if stop in words:
+                words = words[:words.index(stop)]
         words = [w for w in words if w not in DETERMINERS and w not in FILLERS and w not in PRONOUNS
                  and not w.isdigit()]
         # "a bottle of wine" -> "bottle" (the head comes before "of"), unless "of" is in a name.

@@ -81,6 +81,11 @@ CASES: list[tuple[str, tuple, tuple, dict, tuple]] = [
     ("navigate to the plant in the corner of the living room", ("plant",), (), {},
      (("plant", "in", "living_room"),)),
     ("I'd like to go to the fridge in the kitchen", ("fridge",), (), {}, (("fridge", "in", "kitchen"),)),
+    ("go to the chair closest to the fridge", ("chair",), ("fridge",), {}, (("chair", "near", "fridge"),)),
+    ("find the chair nearest the window", ("chair",), ("window",), {}, (("chair", "near", "window"),)),
+    ("In the kitchen, find the chair next to the fridge", ("chair",), ("fridge",), {},
+     (("chair", "next to", "fridge"), ("chair", "in", "kitchen"))),
+    ("find the painting on the wall above the sofa", ("painting",), ("sofa",), {}, (("painting", "above", "sofa"),)),
 ]
 
 
@@ -93,11 +98,20 @@ CASES: list[tuple[str, tuple, tuple, dict, tuple]] = [
     # a room word inside a name ("kitchen table", "bathroom sink") is part of the name
     ("find the kitchen table", ()),
     ("find the bathroom sink", ()),
+    # what is excluded names nothing to look for
+    ("go to the sink in the kitchen not the bathroom", (("sink", "in", "kitchen"),)),
+    ("find the sink in the kitchen, not the one in the bathroom", (("sink", "in", "kitchen"),)),
 ])
 def test_relations_are_kept_only_when_they_can_be_checked(parser, instruction, relations) -> None:
     task = parser.parse(instruction)
     assert task.relations == relations, task.relations
     assert not task.attributes, task.attributes
+
+
+def test_a_superlative_without_a_landmark_is_no_relation(parser) -> None:
+    # "the nearest chair" is the one nearest the robot, not near some object
+    task = parser.parse("find the nearest chair")
+    assert task.targets == ("chair",) and task.relations == ()
 
 
 @pytest.fixture(scope="module")
