@@ -2,14 +2,16 @@
 
 The episode generator (``hiconav episodes --task textnav``) writes instructions from a few
 templates ("take me to the chair next to the fridge"). People say the same thing in other ways:
-a room word before the noun ("the kitchen table"), a follow-up sentence ("Find the chair. The one
+a room word before the noun ("the kitchen table"), the room first ("In the kitchen, find the
+chair ..."), a follow-up sentence ("Find the chair. The one
 next to the fridge."), a relative clause ("the chair that is next to the fridge"), a polite
 lead ("I'd like to go to ..."). A parser that reads only the templates loses the description and
 stops at the first instance of the category it sees.
 
 For each textnav instruction the script writes every form below that applies, decomposes the
 template and each form offline (``decompose_instruction``, MiniLM similarity) and counts a form as
-read when its targets and relations equal the template's. It prints one line per form, the
+read when its targets and the relations on them (what singles the instance out) equal the
+template's; a form the parser fails on counts as not read. It prints one line per form, the
 instructions read differently (up to ``--show``), then one JSON line:
 
     {"instructions": N, "phrasings": P, "agree": A, "rate": A / P, "by_form": {form: rate, ...}}
@@ -35,6 +37,7 @@ from pathlib import Path
 
 from hiconav.reasoning.config import ReasoningConfig
 from hiconav.reasoning.decompose import decompose_instruction
+from hiconav.reasoning.grounding import target_relations
 from hiconav.sim.task_episodes import spoken
 
 LEAD = re.compile(r"^(find|go to|take me to|where is|i'm looking for|navigate to|can you find|please go to) the ",
@@ -61,6 +64,10 @@ def forms(instruction: str, target: str) -> dict[str, str]:
     room = ROOM.fullmatch(rest)
     if room:
         out["room word"] = f"take me to the {room.group(1)} {name}"
+    tail = re.search(r"\s*\b" + ROOM.pattern + "$", rest)
+    if tail:
+        before = rest[:tail.start()].strip()
+        out["leading room"] = f"In the {tail.group(1)}, find the {name}" + (f" {before}" if before else "")
     return out
 
 
@@ -101,8 +108,11 @@ def main(argv: list[str] | None = None) -> int:
     cfg = ReasoningConfig()
 
     def key(text: str):
-        t = decompose_instruction(text, cfg, similarity=similarity)
-        return t.targets, frozenset(t.relations)
+        try:
+            t = decompose_instruction(text, cfg, similarity=similarity)
+        except Exception as exc:  # a parser that fails on a phrasing reads it as nothing
+            return ("error", type(exc).__name__)
+        return t.targets, frozenset(target_relations(t.relations, t.targets))
 
     total = agree = 0
     by_form: dict[str, list[int]] = {}
