@@ -303,7 +303,7 @@ RELATIONS: dict[str, str] = {
 }
 _RELATION_KEYS = sorted(RELATIONS, key=lambda p: -len(p.split()))
 # words after which a noun phrase names what is excluded ("in the kitchen, not the bathroom")
-NEGATIONS = ("not", "rather", "instead", "except")
+NEGATIONS = ("not", "instead", "except")  # "rather" is also an intensifier ("the rather large chair")
 # nouns for a part of a room or of a house, never an object: "in the corner", "at the far end"
 PLACE_NOUNS = frozenset(["corner", "room", "side", "end", "middle", "center", "centre", "area", "space",
                          "part", "place", "spot", "floor", "wall", "back", "front", "edge", "house",

@@ -108,6 +108,10 @@ def test_relations_are_kept_only_when_they_can_be_checked(parser, instruction, r
     assert not task.attributes, task.attributes
 
 
+def test_an_intensifier_is_no_negation(parser) -> None:
+    assert parser.parse("find the rather large sofa next to the lamp").targets == ("sofa",)
+
+
 def test_a_superlative_without_a_landmark_is_no_relation(parser) -> None:
     # "the nearest chair" is the one nearest the robot, not near some object
     task = parser.parse("find the nearest chair")
