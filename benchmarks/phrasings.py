@@ -38,9 +38,10 @@ from pathlib import Path
 from hiconav.reasoning.config import ReasoningConfig
 from hiconav.reasoning.decompose import decompose_instruction
 from hiconav.reasoning.grounding import target_relations
-from hiconav.sim.task_episodes import spoken
+from hiconav.sim.task_episodes import TEXTNAV_PHRASINGS, spoken
 
-LEAD = re.compile(r"^(find|go to|take me to|where is|i'm looking for|navigate to|can you find|please go to) the ",
+# the generator's leading words ("take me to the "), read off its templates
+LEAD = re.compile("^(?:" + "|".join(re.escape(p.split("{np}")[0]) for p in TEXTNAV_PHRASINGS) + ")",
                   re.IGNORECASE)
 ROOM = re.compile(r"in the (kitchen|living room|bedroom|bathroom)")
 

@@ -34,6 +34,8 @@ from typing import Any, Protocol
 import numpy as np
 
 from hiconav.geometry import footprint_gap
+from hiconav.reasoning.decompose import CONTAINMENT
+from hiconav.reasoning.decompose import ROOMS as PARSER_ROOMS
 from hiconav.relations import NEAR, NEXT_TO
 from hiconav.types import label_key
 
@@ -88,10 +90,10 @@ ROOM_CUES: dict[str, tuple[tuple[str, float], ...]] = {
     "tv": (("living_room", 1.5),), "armchair": (("living_room", 1.5),), "floor_lamp": (("living_room", 0.7),),
     "ottoman": (("living_room", 1.0),), "dining_table": (("living_room", 0.5), ("kitchen", 0.5)),
 }
-# room types the instruction parser knows (hiconav.reasoning.decompose.ROOMS) that no room cue
-# infers: the ProcTHOR houses have none of them, and the objects that furnish them (a dining
-# table, a desk, a washing machine) stand in the four rooms above as often
-UNINFERRED_ROOMS = frozenset(["dining_room", "hallway", "office", "laundry_room", "garage"])
+# room types the instruction parser knows that no room cue infers (dining room, hallway, office,
+# laundry room, garage): the ProcTHOR houses have none of them, and the objects that furnish them
+# (a dining table, a desk, a washing machine) stand in the four rooms above as often
+UNINFERRED_ROOMS = frozenset(PARSER_ROOMS.values()) - frozenset(ROOMS)
 NEAR_WORDS = frozenset(["near", "left of", "right of", "in front of", "behind", "facing", "opposite", "at",
                         "with", "against", "by"])
 
@@ -232,7 +234,7 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
         # "the table in the dining room": a room type no cue of ROOM_CUES tells apart; waiting
         # for its evidence would hold the search forever, so the words are not checked
         return "holds", f"a {obj.replace('_', ' ')} is no room type the map infers (not checked)"
-    if room is not None and rel.strip().lower() in ("in", "at", "inside", "within"):
+    if room is not None and rel.strip().lower() in CONTAINMENT:
         seen, score = rooms.get(node.id, (None, 0.0))
         if seen is None:
             return "unknown", "no room cue seen with it"
