@@ -36,6 +36,13 @@ def _num(value: float | None, digits: int = 2) -> str:
     return "-" if value is None else f"{value:.{digits}f}"
 
 
+def _interval(value: float | None, ci: Sequence[float] | None) -> str:
+    """"63.6 [53.8, 72.5]": a percentage and its 95% interval."""
+    if ci is None:
+        return _pct(value)
+    return f"{_pct(value)} [{_pct(ci[0])}, {_pct(ci[1])}]"
+
+
 def _signed(value: float | None) -> str:
     return "-" if value is None else f"{100.0 * value:+.1f}"
 
@@ -74,27 +81,35 @@ def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
     rows = []
     for name, group in presets.items():
         rows.append([name, DESCRIPTIONS.get(name, name), str(group["episodes"]), str(group["valid_episodes"]),
-                     _pct(group["success_rate"]), _pct(group["spl"]), _num(group["dts"]),
+                     _interval(group["success_rate"], group.get("success_rate_ci95")),
+                     _interval(group["spl"], group.get("spl_ci95")), _num(group["dts"]),
                      ", ".join(group["detectors"]) or "-", ", ".join(group["reasoners"]) or "-"])
-    lines += _table(["Preset", "Method", "Episodes", "Valid", "SR (%)", "SPL (%)", "DTS (m)",
+    lines += _table(["Preset", "Method", "Episodes", "Valid", "SR (%) [95% CI]", "SPL (%) [95% CI]", "DTS (m)",
                      "Detector", "Reasoner"], rows)
     lines += [("SR and SPL over valid episodes (invalid input is counted but not run); SPL's shortest path "
                "is the geodesic distance from the start to the success region (runs recorded before "
                "December 2026 measured it to the goal object; `python -m hiconav.eval.rescore OUT` "
-               "rescores them); DTS is the mean geodesic distance to the success region at the end."), ""]
+               "rescores them); DTS is the mean geodesic distance to the success region at the end. "
+               "Intervals: Wilson score for SR, a seeded percentile bootstrap for SPL; "
+               "`python -m hiconav.eval.compare BEFORE AFTER` compares two runs episode by episode."), ""]
 
     ablations: dict[str, dict[str, Any]] = summary.get("ablations", {})
     lines += ["## Ablations", ""]
     if ablations:
         rows = [[DESCRIPTIONS.get(main, str(main)) + " (reference)", "-",
                  _pct(next(iter(ablations.values()))["reference_success_rate"]),
-                 _pct(next(iter(ablations.values()))["reference_spl"]), "", ""]]
+                 _pct(next(iter(ablations.values()))["reference_spl"]), "", "", "", ""]]
         for name, delta in ablations.items():
+            p = delta.get("sign_test_p")
             rows.append([DESCRIPTIONS.get(name, name), str(delta["paired_episodes"]),
                          _pct(delta["success_rate"]), _pct(delta["spl"]),
-                         _signed(delta["delta_success_rate"]), _signed(delta["delta_spl"])])
-        lines += _table(["Method", "Paired episodes", "SR (%)", "SPL (%)", "dSR (pts)", "dSPL (pts)"], rows)
-        lines += [f"Deltas are paired: each preset against `{main}` on the episodes both ran, same seeds.", ""]
+                         _signed(delta["delta_success_rate"]), _signed(delta["delta_spl"]),
+                         f"{delta.get('up', '-')} / {delta.get('down', '-')}", "-" if p is None else f"{p:.3f}"])
+        lines += _table(["Method", "Paired episodes", "SR (%)", "SPL (%)", "dSR (pts)", "dSPL (pts)",
+                         "up / down", "sign test p"], rows)
+        lines += [f"Deltas are paired: each preset against `{main}` on the episodes both ran, same seeds; "
+                  "up / down: episodes that turned into a success / out of one; the exact sign test's "
+                  "p-value says how likely so lopsided a split is by chance.", ""]
     else:
         lines += ["Only one preset ran; run `--preset ablations` for this table.", ""]
 

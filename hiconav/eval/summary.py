@@ -25,6 +25,7 @@ from typing import Any
 
 from hiconav.eval.presets import PRESETS
 from hiconav.eval.records import EpisodeRecord
+from hiconav.eval.stats import bootstrap_interval, sign_test_p, wilson_interval
 from hiconav.eval.taxonomy import CATEGORIES, Failure
 
 
@@ -77,11 +78,15 @@ def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
         by_target[target] = {"episodes": len(group),
                              "success_rate": _mean([float(r.success) for r in group]),
                              "spl": _mean([float(r.spl) for r in group])}
+    sr_ci = wilson_interval(sum(bool(r.success) for r in valid), len(valid))
+    spl_ci = bootstrap_interval([float(r.spl) for r in valid])
     return {
         "episodes": len(records),
         "valid_episodes": len(valid),
         "success_rate": _mean([float(r.success) for r in valid]),
+        "success_rate_ci95": list(sr_ci) if sr_ci else None,  # Wilson score interval
         "spl": _mean([float(r.spl) for r in valid]),
+        "spl_ci95": list(spl_ci) if spl_ci else None,  # percentile bootstrap, seeded
         "dts": _mean(dts_known),
         "dts_unknown": len(valid) - len(dts_known),
         "failures": failures,
@@ -111,6 +116,8 @@ def ablation_deltas(records: Sequence[EpisodeRecord], reference: str = "full") -
         if not pairs:
             continue
         n = len(pairs)
+        up = sum(1 for a, b in pairs if b.success and not a.success)
+        down = sum(1 for a, b in pairs if a.success and not b.success)
         out[preset] = {
             "paired_episodes": n,
             "success_rate": sum(float(b.success) for _, b in pairs) / n,
@@ -119,6 +126,9 @@ def ablation_deltas(records: Sequence[EpisodeRecord], reference: str = "full") -
             "reference_spl": sum(a.spl for a, _ in pairs) / n,
             "delta_success_rate": sum(float(b.success) - float(a.success) for a, b in pairs) / n,
             "delta_spl": sum(b.spl - a.spl for a, b in pairs) / n,
+            # episodes that turned into a success / out of one against the reference, and the
+            # exact sign test on them (``hiconav.eval.stats``): is the SR difference more than chance?
+            "up": up, "down": down, "sign_test_p": sign_test_p(up, down),
         }
     return out
 
