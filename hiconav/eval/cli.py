@@ -179,6 +179,8 @@ def eval(
     summary = evaluate(specs, out, config, run_info={"command": command,
                                                      "source": str(houses or maps), "episodes": len(specs)})
     sr, spl = summary.get("success_rate"), summary.get("spl")
+    ci = summary.get("success_rate_ci95")
     typer.echo(f"{summary['episodes']} episodes ({summary['preset']}): "
-               f"SR {sr if sr is None else round(sr, 3)}  SPL {spl if spl is None else round(spl, 3)}  "
-               f"-> {Path(out) / 'report.md'}")
+               f"SR {sr if sr is None else round(sr, 3)}"
+               + (f" [95% CI {ci[0]:.3f}, {ci[1]:.3f}]" if ci else "")
+               + f"  SPL {spl if spl is None else round(spl, 3)}  -> {Path(out) / 'report.md'}")

@@ -68,6 +68,8 @@ def test_gibson_run_with_a_custom_runner_writes_outputs(tmp_path, shared_data) -
     assert result.exit_code == 0, result.output
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["episodes"] == 2
+    lo, hi = summary["success_rate_ci95"]  # the last line gives the SR with its interval
+    assert f"[95% CI {lo:.3f}, {hi:.3f}]" in result.output
 
 
 def test_set_values_are_parsed_as_yaml_and_bad_ones_rejected() -> None:
