@@ -202,7 +202,8 @@ class OfflineVerifier:
     observed >= ``min_observations`` times. When the instruction describes one instance (relations
     whose subject is the target: "the armchair next to the floor lamp in the living room"), the
     node must also satisfy every such relation on the subgraph (``grounding.ground``: rooms
-    inferred from the objects seen with it, relations on the nodes' 3D boxes). The hypothesis
+    inferred from the objects seen with it, relations on the nodes' 3D boxes), grounded only on
+    nodes that pass the same confidence and observation floors as the target's own. The hypothesis
     uses the anchor in which the node's box is largest. Attributes are not checked (said in the
     evidence).
     """
@@ -229,6 +230,16 @@ class OfflineVerifier:
                     best, best_t = s, t
         return best, best_t
 
+    def _weak(self, obj: ObjectLike) -> str | None:
+        """Why a node is seen too weakly to count (LOW_CONFIDENCE, FEW_OBSERVATIONS), or None."""
+        cfg = self.config.offline
+        if obj.confidence < cfg.min_confidence and not (cfg.confident_observations
+                                                        and obj.n_obs >= cfg.confident_observations):
+            return LOW_CONFIDENCE
+        if obj.n_obs < cfg.min_observations:
+            return FEW_OBSERVATIONS
+        return None
+
     def verify(self, subgraph: SubgraphLike, task: TaskSpec) -> VerifyResult:
         t0 = time.perf_counter()
         try:
@@ -248,18 +259,19 @@ class OfflineVerifier:
         described = bool(target_relations(task.relations, task.targets))
         objects = list(subgraph.objects)
         context = list(getattr(subgraph, "context", ()) or ())
-        rooms = infer_rooms(objects + context, ignore=task.targets) if described else None
+        # the related objects a relation is grounded on must be seen as surely as a target must
+        # be: a detector's false positive or confused label ("sink" on a bathtub) seen once
+        # would otherwise confirm the wrong instance beside it
+        support = [o for o in objects + context if self._weak(o) is None] if described else []
+        # and so must the objects that tell a room (a false "bed" makes a bedroom)
+        rooms = infer_rooms(support, ignore=task.targets) if described else None
         groundings: dict[int, Any] = {}
         for obj in subgraph.objects:
             score, target = self._match(obj.label, task.targets)
             if score < 1.0 and score < cfg.min_similarity:
                 continue
-            if obj.confidence < cfg.min_confidence and not (cfg.confident_observations
-                                                            and obj.n_obs >= cfg.confident_observations):
-                reasons.append(LOW_CONFIDENCE)
-                continue
-            if obj.n_obs < cfg.min_observations:
-                reasons.append(FEW_OBSERVATIONS)
+            if (weak := self._weak(obj)) is not None:
+                reasons.append(weak)
                 continue
             view = self._best_view(obj, anchors)
             if view is None:
@@ -267,7 +279,7 @@ class OfflineVerifier:
                 continue
             if described:
                 # relations on the map: the subgraph's objects and the nodes mapped near it
-                verdict = ground(obj, objects + context, task.relations, task.targets, rooms)
+                verdict = ground(obj, support, task.relations, task.targets, rooms)
                 groundings[obj.id] = verdict
                 if verdict.status != "holds":
                     reasons.append(RELATION_FAILED if verdict.status == "fails" else RELATION_UNKNOWN)

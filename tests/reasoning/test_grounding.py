@@ -249,3 +249,34 @@ def test_the_described_category_gives_no_room_cue_of_its_own():
     assert infer_rooms(scene)[1][0] == "living_room"  # by its own cue
     assert infer_rooms(scene, ignore=("tv",))[1][0] == "bedroom"
     assert ground(scene[0], scene, task.relations, task.targets).status == "holds"
+
+
+def test_a_related_object_seen_too_weakly_to_count_grounds_no_relation():
+    from dataclasses import replace
+
+    task = decompose_instruction("please go to the painting next to the sink")
+    painting = node(1, "painting", (0, 0), (0.8, 0.05), (1.2, 1.8))
+    sink = node(2, "sink", (0.6, 0.4), (0.5, 0.4), (0.0, 0.9))  # 0.35 m from the painting
+    verifier = OfflineVerifier(ReasoningConfig())
+    result = verifier.verify(graph([painting, sink]), task)
+    assert result.found and result.verdicts == {1: "holds"}
+    # the same sink seen once, or at a confidence a detector's false positive has: it proves
+    # nothing yet, so the painting is unresolved (not ruled out) until the sink is seen again
+    for weak in (replace(sink, n_obs=1), replace(sink, confidence=0.2)):
+        result = verifier.verify(graph([painting, weak]), task)
+        assert not result.found and result.reason == RELATION_UNKNOWN and result.verdicts == {1: "unknown"}
+    # a node seen often enough passes the confidence floor, as the target's own node does
+    steady = replace(sink, confidence=0.2, n_obs=ReasoningConfig().offline.confident_observations)
+    assert verifier.verify(graph([painting, steady]), task).found
+
+
+def test_a_room_cue_seen_too_weakly_to_count_tells_no_room():
+    from dataclasses import replace
+
+    task = decompose_instruction("take me to the tv in the bedroom")
+    tv, bed = node(1, "tv", (0, 0), (1.0, 0.1), (0.8, 1.4)), node(2, "bed", (0, 1.5), (1.6, 2.0))
+    verifier = OfflineVerifier(ReasoningConfig())
+    assert verifier.verify(graph([tv, bed]), task).verdicts == {1: "holds"}
+    # a "bed" seen once (a false detection, or a sofa taken for a bed) makes no bedroom yet
+    result = verifier.verify(graph([tv, replace(bed, n_obs=1)]), task)
+    assert not result.found and result.verdicts == {1: "unknown"}
