@@ -13,7 +13,8 @@ test on those, and the paired SPL difference with its bootstrap interval
      "sign_test_p": p, "delta_sr": x, "delta_spl": y, "delta_spl_ci95": [lo, hi], ...}
 
 A change whose ``up`` and ``down`` a sign test cannot tell apart (p well above 0.05) has not been
-shown to do anything: on 100 episodes, four up and one down is p = 0.375. It reads files only.
+shown to do anything: four up and one down is p = 0.375, however many episodes ran. It reads
+files only.
 """
 
 from __future__ import annotations
@@ -34,7 +35,10 @@ def _records(path: Path, preset: str | None) -> list[Any]:
     if not file.is_file():
         raise DataError("no episode records here (an `hiconav eval` --out folder or its episodes.jsonl)",
                         file=str(path))
-    records = read_records(file)
+    try:
+        records = read_records(file)  # a bad line raises DataError naming it
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DataError(f"cannot read episode records: {exc}", file=str(file)) from exc
     presets = sorted({r.preset for r in records})
     if preset is None:
         if len(presets) > 1:

@@ -96,3 +96,10 @@ def test_compare_names_the_file_when_a_preset_is_missing_or_ambiguous(tmp_path, 
                          "--preset-after", "no_vis"]) == 0
     assert json.loads(capsys.readouterr().out.splitlines()[-1])["down"] == 1
     assert compare_main([str(tmp_path / "nowhere"), str(tmp_path / "run")]) == 2
+    (tmp_path / "bad.jsonl").write_text(dumps(rec(0, True, 0.5)) + "\n{not json\n" + dumps(rec(1, True)) + "\n")
+    assert compare_main([str(tmp_path / "bad.jsonl"), str(tmp_path / "run"), "--preset", "full"]) == 2
+    err = capsys.readouterr().err
+    assert "bad.jsonl:2: not a JSON line" in err
+    (tmp_path / "binary.jsonl").write_bytes(b"\xff\xfe\x00garbage\n")
+    assert compare_main([str(tmp_path / "binary.jsonl"), str(tmp_path / "run"), "--preset", "full"]) == 2
+    assert "cannot read episode records" in capsys.readouterr().err
