@@ -24,6 +24,8 @@ from typing import Any
 
 import numpy as np
 
+from hiconav.eval.taxonomy import Failure
+
 Z95 = 1.959963984540054  # the standard normal's 97.5% quantile
 BOOTSTRAP_RESAMPLES = 2000
 BOOTSTRAP_SEED = 0
@@ -67,8 +69,19 @@ def sign_test_p(up: int, down: int) -> float:
     return min(1.0, 2.0 * tail)
 
 
+def turned(pairs: Iterable[tuple[Any, Any]]) -> tuple[list[str], list[str]]:
+    """The episode ids of (before, after) record pairs that turned into a success (``up``) and out
+    of one (``down``): what the sign test counts."""
+    up: list[str] = []
+    down: list[str] = []
+    for a, b in pairs:
+        if bool(a.success) != bool(b.success):
+            (up if b.success else down).append(b.episode_id)
+    return up, down
+
+
 def _by_id(records: Iterable[Any]) -> dict[str, Any]:
-    return {r.episode_id: r for r in records if r.failure != "invalid_episode"}
+    return {r.episode_id: r for r in records if r.failure != Failure.INVALID_EPISODE.value}
 
 
 def paired_comparison(before: Iterable[Any], after: Iterable[Any]) -> dict[str, Any]:
@@ -80,8 +93,7 @@ def paired_comparison(before: Iterable[Any], after: Iterable[Any]) -> dict[str, 
     a, b = _by_id(before), _by_id(after)
     ids = sorted(set(a) & set(b))
     n = len(ids)
-    up = [i for i in ids if b[i].success and not a[i].success]
-    down = [i for i in ids if a[i].success and not b[i].success]
+    up, down = turned((a[i], b[i]) for i in ids)
     d_spl = [float(b[i].spl) - float(a[i].spl) for i in ids]
 
     def side(recs: dict[str, Any]) -> dict[str, Any]:
@@ -101,4 +113,4 @@ def paired_comparison(before: Iterable[Any], after: Iterable[Any]) -> dict[str, 
             "up_ids": up, "down_ids": down}
 
 
-__all__ = ["bootstrap_interval", "paired_comparison", "sign_test_p", "wilson_interval"]
+__all__ = ["bootstrap_interval", "paired_comparison", "sign_test_p", "turned", "wilson_interval"]

@@ -25,7 +25,7 @@ from typing import Any
 
 from hiconav.eval.presets import PRESETS
 from hiconav.eval.records import EpisodeRecord
-from hiconav.eval.stats import bootstrap_interval, sign_test_p, wilson_interval
+from hiconav.eval.stats import bootstrap_interval, sign_test_p, turned, wilson_interval
 from hiconav.eval.taxonomy import CATEGORIES, Failure
 
 
@@ -116,8 +116,7 @@ def ablation_deltas(records: Sequence[EpisodeRecord], reference: str = "full") -
         if not pairs:
             continue
         n = len(pairs)
-        up = sum(1 for a, b in pairs if b.success and not a.success)
-        down = sum(1 for a, b in pairs if a.success and not b.success)
+        up, down = (len(ids) for ids in turned(pairs))
         out[preset] = {
             "paired_episodes": n,
             "success_rate": sum(float(b.success) for _, b in pairs) / n,
