@@ -24,7 +24,9 @@ goal's success region).
   its clauses, read generously (any object of the anchor category, a ProcTHOR parent or the box
   geometry, an unknown room counts as any room), while the described instance satisfies each
   clause strictly (the anchor is a visible landmark, its ProcTHOR parent *and* the geometry for
-  "on"). The shortest description wins: room, one relation, room and relation, two relations;
+  "on", and the anchor stands in the described instance's room: a person by a painting on a
+  bathroom wall does not call it "next to" the armchair on the wall's living room side, however
+  small the planar gap through the wall; ``GroundTruth.same_side``). The shortest description wins: room, one relation, room and relation, two relations;
   an instance that no description singles out is not used.
 
 Generation is deterministic per (houses file line, task, n, seed). Reading checks each line
@@ -170,20 +172,34 @@ class GroundTruth:
         self.house = house
         self.things = [thing_of(o) for o in house.objects]
         self._visible = visible
-        self._rooms: dict[int, str | None] = {}
+        self._rooms: dict[int, int | None] = {}
         self._memo: dict[tuple[str, int, Clause], bool] = {}
 
     def room_of(self, iid: int) -> str | None:
         """The ProcTHOR roomType of the room whose polygon holds the object's centre (or lies
         within ``ROOM_SNAP`` of it), None if none does."""
+        k = self.room_index(iid)
+        return None if k is None else self.house.rooms[k].room_type
+
+    def room_index(self, iid: int) -> int | None:
+        """The index in ``house.rooms`` of the room that holds the object (``room_of``'s rule),
+        None if none does: two bedrooms are two rooms."""
         if iid not in self._rooms:
             xy = self.things[iid].center
-            room = next((r.room_type for r in self.house.rooms if in_polygon(xy, r.polygon)), None)
+            room = next((k for k, r in enumerate(self.house.rooms) if in_polygon(xy, r.polygon)), None)
             if room is None and self.house.rooms:
-                d, room = min((polygon_distance(xy, r.polygon), r.room_type) for r in self.house.rooms)
-                room = room if d <= ROOM_SNAP else None
+                d, k = min((polygon_distance(xy, r.polygon), k) for k, r in enumerate(self.house.rooms))
+                room = k if d <= ROOM_SNAP else None
             self._rooms[iid] = room
         return self._rooms[iid]
+
+    def same_side(self, a: int, b: int) -> bool:
+        """Whether a person standing by one of the two objects sees the other beside it: both
+        stand in one room, or the house does not say (an object in no room polygon). A painting
+        on a bathroom's wall is not "next to" the armchair on the living room's side of that
+        wall, however small the planar gap through it."""
+        ra, rb = self.room_index(a), self.room_index(b)
+        return ra is None or rb is None or ra == rb
 
     def is_landmark(self, iid: int) -> bool:
         """Whether a description may name this object: a landmark category, a real (not
@@ -193,8 +209,12 @@ class GroundTruth:
             return False
         return True if self._visible is None else bool(self._visible(iid))
 
-    def _related(self, relation: str, a: int, b: int) -> bool:
-        return holds(relation, self.things[a], self.things[b])
+    def _related(self, relation: str, a: int, b: int, *, strict: bool = True) -> bool:
+        """``a <relation> b`` by the geometry; read strictly, also as a person sees it: the two
+        in one room (``same_side``). The generous reading (``may_satisfy``) keeps the geometry
+        alone, so that no other instance satisfies a description even for a reader who ignores
+        walls."""
+        return holds(relation, self.things[a], self.things[b]) and (not strict or self.same_side(a, b))
 
     def may_satisfy(self, iid: int, clause: Clause) -> bool:
         """Whether ``iid`` might be what the clause describes (read generously; memoised)."""
@@ -220,7 +240,7 @@ class GroundTruth:
         obj = self.house.objects[iid]
         if kind == "on" and obj.parent_id is not None and self.house.objects[obj.parent_id].category == what:
             return True
-        return any(self._related(kind, iid, o.instance_id) for o in self.house.objects
+        return any(self._related(kind, iid, o.instance_id, strict=False) for o in self.house.objects
                    if o.category == what and o.instance_id != iid)
 
     def _satisfies(self, iid: int, clause: Clause) -> bool:

@@ -196,6 +196,44 @@ def test_a_landmark_beside_one_twin_describes_it_and_only_it() -> None:
     assert truth.describe(2) is None
 
 
+def _two_rooms_split_by_a_wall():
+    """A bathroom (x < 3) and a living room (x > 3) sharing the wall x = 3; a painting hangs on
+    each side of that wall at its south end, an armchair stands against the living room's side
+    0.2 m from it, and one more painting hangs on the bathroom's west wall."""
+    from hiconav.sim.house import Room, Wall, assemble_house
+
+    walls = [Wall((0.0, 0.0), (6.0, 0.0), 2.5, 0.1), Wall((6.0, 0.0), (6.0, 4.0), 2.5, 0.1),
+             Wall((6.0, 4.0), (0.0, 4.0), 2.5, 0.1), Wall((0.0, 4.0), (0.0, 0.0), 2.5, 0.1),
+             Wall((3.0, 0.0), (3.0, 2.8), 2.5, 0.1)]
+    rooms = [Room("room|0", "Bathroom", np.array([[0, 0], [3, 0], [3, 4], [0, 4]], float)),
+             Room("room|1", "LivingRoom", np.array([[3, 0], [6, 0], [6, 4], [3, 4]], float))]
+    objects = [obj(0, "painting", (2.93, 1.0, 1.5), (0.04, 0.8, 0.6)),  # bathroom side of x = 3
+               obj(1, "armchair", (3.45, 1.0, 0.45), (0.7, 0.8, 0.9)),  # living room side
+               obj(2, "painting", (0.07, 2.0, 1.5), (0.04, 0.8, 0.6))]
+    return assemble_house("two rooms", rooms, walls, objects)
+
+
+def test_a_relation_through_a_wall_describes_nothing_a_person_sees() -> None:
+    truth = GroundTruth(_two_rooms_split_by_a_wall())
+    assert holds("next to", truth.things[0], truth.things[1])  # 0.13 m apart in plan, through the wall
+    assert not truth.same_side(0, 1)
+    assert not truth.satisfies(0, ("next to", "armchair"))  # read as a person reads it
+    assert truth.may_satisfy(0, ("next to", "armchair"))  # read generously: a reader ignoring walls
+    assert ("next to", "armchair") not in truth.candidate_clauses(0)
+    assert truth.describe(0) != [("next to", "armchair")]
+
+
+def test_a_relation_within_one_room_still_describes() -> None:
+    from dataclasses import replace
+
+    house = _two_rooms_split_by_a_wall()
+    house.objects[1] = replace(house.objects[1], center=np.array([2.45, 1.0, 0.45]))  # now in the bathroom
+    truth = GroundTruth(house)
+    assert truth.same_side(0, 1)
+    assert truth.satisfies(0, ("next to", "armchair"))
+    assert truth.describe(0) == [("next to", "armchair")]
+
+
 def test_on_needs_the_parent_and_the_geometry_for_the_goal() -> None:
     from dataclasses import replace
 
