@@ -208,12 +208,18 @@ def test_without_an_endpoint_the_offline_parser_answers() -> None:
 
 
 # ---------------------------------------------------------------------------- VLM backend
+def _patient(base_url: str):
+    """``fast_config`` with a timeout no busy machine reaches: these servers reply at once, and a
+    0.3 s timeout failed a reply test while the suite shared two cores with other work."""
+    return fast_config(base_url, timeout_s=10.0, connect_timeout_s=10.0)
+
+
 DECOMP = load_manifest()["decomposition"]
 
 
 @pytest.mark.parametrize("case", DECOMP, ids=[c["name"] for c in DECOMP])
 def test_vlm_decomposition_replies(server, case) -> None:
-    config = fast_config(server.base_url).model_copy(update={"fallback_to_offline": False})
+    config = _patient(server.base_url).model_copy(update={"fallback_to_offline": False})
     server.script(case["file"])
     expect = case["expect"]
     if expect["ok"]:
@@ -230,7 +236,7 @@ def test_vlm_decomposition_replies(server, case) -> None:
 
 
 def test_vlm_failure_falls_back_to_the_offline_parser(server) -> None:
-    config = fast_config(server.base_url)
+    config = _patient(server.base_url)
     server.script(*[{"file": "http_500.json", "status": 500}] * 2)
     task = decompose_instruction("find the blue mug beside the sink", config, similarity=no_similarity)
     assert task.source == "offline" and task.targets == ("mug",)
@@ -239,12 +245,12 @@ def test_vlm_failure_falls_back_to_the_offline_parser(server) -> None:
 
 def test_an_invalid_vlm_decomposition_falls_back_too(server) -> None:
     server.script("decomp_injection.json")
-    task = decompose_instruction("go to the couch", fast_config(server.base_url), similarity=no_similarity)
+    task = decompose_instruction("go to the couch", _patient(server.base_url), similarity=no_similarity)
     assert task.source == "offline" and task.targets == ("sofa",)
 
 
 def test_backend_offline_ignores_the_endpoint(server) -> None:
-    config = fast_config(server.base_url).model_copy(update={"backend": "offline"})
+    config = _patient(server.base_url).model_copy(update={"backend": "offline"})
     server.script("decomp_good.json")
     task = decompose_instruction("go to the couch", config, similarity=no_similarity)
     assert task.source == "offline" and server.requests == []
