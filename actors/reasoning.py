@@ -24,7 +24,7 @@ from hiconav.actors.runtime import NodeActor
 
 from hiconav.messages import (ExploredOut, HypothesisMsg, ParseRequest, ReasoningBusy, RuledOut, TargetRejected,
                               TaskMsg, WorldSnapshot)
-from hiconav.reasoning.unresolved import unresolved_hypothesis
+from hiconav.reasoning.unresolved import due_marginal, track_marginal, unresolved_hypothesis
 
 
 class ReasoningActor(NodeActor):
@@ -39,7 +39,8 @@ class ReasoningNode(Node):
                  verifier: Any = None, decompose: Callable[..., list] | None = None,
                  similarity: Callable[[str, str], float] | None = None, k: int = 5, rate_hz: float = 10.0,
                  stepped: bool = True, latency_s: Any = None, parse_latency_s: Any = None,
-                 task_to: tuple[str, ...] = ("mission", "exploration", "memory"), sync: bool = False) -> None:
+                 task_to: tuple[str, ...] = ("mission", "exploration", "memory"), sync: bool = False,
+                 marginal_patience_s: float = 0.0) -> None:
         super().__init__(rate_hz)
         self.parse = parse
         self.make_reasoner = make_reasoner
@@ -52,6 +53,8 @@ class ReasoningNode(Node):
         self.parse_latency_s = parse_latency_s
         self.task_to = task_to
         self.sync = sync  # tell control when a call is in flight (it holds the robot still)
+        self.marginal_patience_s = float(marginal_patience_s)
+        self._marginal_since: dict[int, float] = {}  # object id -> clock s since its verdict is "marginal"
         self.task = None
         self.reasoner: Any = None
         self.busy_until = 0.0
@@ -83,6 +86,7 @@ class ReasoningNode(Node):
         self._ruled_out = frozenset()  # exploration forgets its set on the new TaskMsg too
         self._explored_out = False
         self._offered = set()
+        self._marginal_since = {}
         self.reasoner = self.make_reasoner(task) if self.make_reasoner is not None else None
 
     def _on_rejected(self, msg: TargetRejected, now: float) -> None:
@@ -118,6 +122,7 @@ class ReasoningNode(Node):
         """Tell exploration which target-category nodes the relations rule out, when that set
         changes (a later verdict that holds or is unknown takes a node back)."""
         self.verdicts.update(getattr(result, "verdicts", None) or {})
+        self._marginal_since = track_marginal(self._marginal_since, self.verdicts, now)
         ruled_out = frozenset(i for i, v in self.verdicts.items() if v == "fails")
         if ruled_out != self._ruled_out:
             self._ruled_out = ruled_out
@@ -144,6 +149,9 @@ class ReasoningNode(Node):
             self._explored_out = False
             if self._offer_unresolved(now):
                 return
+        due = due_marginal(self._marginal_since, now, self.marginal_patience_s, exclude=self._offered)
+        if due and self._offer_unresolved(now, due, f"no clearer instance in {self.marginal_patience_s:g} s"):
+            return
         if (snap is None or self.reasoner is None or self.verifier is None or self.decompose is None
                 or snap.memory is None or self.reasoner.done):
             return
@@ -165,21 +173,28 @@ class ReasoningNode(Node):
             self.emit(("mission", "memory", "recorder"), HypothesisMsg(result.hypothesis, now + delay, now, "", result.detail,
                                                            str(getattr(subgraph, "kind", ""))), delay)
 
-    def _offer_unresolved(self, now: float) -> bool:
-        """The search explored out: send the best unresolved candidate of a described instance
-        (``hiconav.reasoning.unresolved``) as a hypothesis, one not offered before; a reasoning
-        call like any other (it takes the modelled latency). True when one was sent."""
+    def _offer_unresolved(self, now: float, verdicts: dict[int, str] | None = None,
+                          why: str = "the search explored out") -> bool:
+        """Send the best unresolved candidate of a described instance (``hiconav.reasoning.unresolved``)
+        among ``verdicts`` (default: all judged) as a hypothesis, one not offered before: when
+        the search explored out, or a marginal one's patience ran out; a reasoning call like any
+        other (it takes the modelled latency). True when one was sent."""
         if self.task is None or self._memory is None or (self.reasoner is not None and self.reasoner.done):
             return False
-        hyp = unresolved_hypothesis(self._memory, self.verdicts, self.task.targets, exclude=self._offered)
+        hyp = unresolved_hypothesis(self._memory, self.verdicts if verdicts is None else verdicts,
+                                    self.task.targets, exclude=self._offered, why=why)
         if hyp is None:
-            self.events.append({"t": now, "kind": "unresolved", "found": False, "reason": "none left"})
+            if verdicts is None:
+                self.events.append({"t": now, "kind": "unresolved", "found": False, "reason": "none left"})
+            else:  # the marginal nodes are gone from memory (merged): never offered
+                self._offered.update(verdicts)
             return False
         self._offered.add(int(hyp.object_id))
         self.requests += 1
         delay = self._delay(self.latency_s, 0.0)
         self._busy(now, delay)
-        self.events.append({"t": now, "kind": "unresolved", "found": True, "reason": "explored out",
+        self.events.append({"t": now, "kind": "unresolved", "found": True,
+                            "reason": "explored out" if verdicts is None else "marginal",
                             "latency_s": delay, "source": hyp.source, "detail": hyp.evidence[:400]})
         self.emit(("mission", "memory", "recorder"),
                   HypothesisMsg(hyp, now + delay, now, "", hyp.evidence, "unresolved"), delay)

@@ -255,7 +255,8 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
                               verifier=verifier if cfg.reasoning else None, decompose=decompose,
                               similarity=similarity, k=r_cfg.k,
                               rate_hz=rates.reasoning, stepped=stepped, latency_s=vlm_latency,
-                              parse_latency_s=parse_latency, sync=cfg.sync_reasoning)
+                              parse_latency_s=parse_latency, sync=cfg.sync_reasoning,
+                              marginal_patience_s=r_cfg.marginal_patience_s)
     exploration = ExplorationNode(tracker, planner, rate_hz=rates.exploration, similarity=similarity)
     control = ControlNode(Navigator(nav_cfg), rate_hz=rates.control, mode=cfg.control_mode,
                           velocity_dt=1.0 / rates.control, hold_while_reasoning=cfg.sync_reasoning)

@@ -19,8 +19,10 @@ for a subgraph (the VLM path answers the same question from the subgraph's image
   ``between`` near both. View-dependent words (left of, behind, in front of, ...) have no fixed
   meaning without the speaker's viewpoint and are read as ``near`` (a labelled approximation).
 
-Verdicts are "holds", "fails" or "unknown" (the related object is not in the subgraph, or no room
-can be inferred), so a described instance is confirmed only when every relation holds. Pure
+Verdicts are "holds", "marginal" (every relation holds, some only within the memory boxes'
+noise margin: ``relation_grade``), "fails" or "unknown" (the related object is not in the
+subgraph, or no room can be inferred), so a described instance is confirmed only when every
+relation holds; a marginal one is offered after a wait (``unresolved.due_marginal``). Pure
 functions; no I/O, no clocks.
 """
 
@@ -132,21 +134,39 @@ def _centre_in_plan(a: BoxLike, b: BoxLike, pad: float = 0.10) -> bool:
 
 
 def relation_holds(relation: str, a: BoxLike, b: BoxLike) -> bool:
-    """Whether ``a`` stands in ``relation`` to ``b`` (both object boxes; see the module's list)."""
+    """Whether ``a`` stands in ``relation`` to ``b`` (both object boxes; see the module's list),
+    read with the box-noise margins: "holds" or "marginal" by ``relation_grade``."""
+    return relation_grade(relation, a, b) != "fails"
+
+
+def relation_grade(relation: str, a: BoxLike, b: BoxLike) -> str:
+    """"holds" when ``a`` stands in ``relation`` to ``b`` as the ground truth's predicate reads
+    it (planar gap within ``NEXT_TO`` / ``NEAR``, stacked boxes overlapping in plan within
+    ``BOX_NOISE_M``); "marginal" when it does so only within the memory boxes' noise margin
+    (``NEXT_TO_M``, ``NEAR_M``, ``STACK_PAD_M``); else "fails". A marginal relation may be a true
+    one read through a box that stops short of its object, or a false one: the instance beside
+    the described one, a few centimetres past the words' reach."""
     rel = relation.strip().lower()
     if rel == "on":
-        return _centre_in_plan(a, b) and abs(float(a.box_min[2]) - float(b.box_max[2])) <= ON_GAP_M
-    if rel in ("under", "below"):
-        return _plan_overlap(a, b, STACK_PAD_M) and float(b.box_min[2]) >= float(a.box_max[2]) - ON_GAP_M
-    if rel == "above":
-        return _plan_overlap(a, b, STACK_PAD_M) and float(a.box_min[2]) >= float(b.box_max[2]) - ON_GAP_M
+        ok = _centre_in_plan(a, b) and abs(float(a.box_min[2]) - float(b.box_max[2])) <= ON_GAP_M
+        return "holds" if ok else "fails"
+    if rel in ("under", "below", "above"):
+        top, low = (b, a) if rel != "above" else (a, b)
+        if float(top.box_min[2]) < float(low.box_max[2]) - ON_GAP_M:
+            return "fails"
+        if _plan_overlap(a, b, BOX_NOISE_M):
+            return "holds"
+        return "marginal" if _plan_overlap(a, b, STACK_PAD_M) else "fails"
     if rel == "in":
-        return _centre_in_plan(a, b, pad=0.0) and float(b.box_min[2]) - 0.1 <= float(a.box_min[2]) <= float(b.box_max[2])
-    if rel == "next to":
-        return planar_gap(a, b) <= NEXT_TO_M
+        ok = _centre_in_plan(a, b, pad=0.0) and float(b.box_min[2]) - 0.1 <= float(a.box_min[2]) <= float(b.box_max[2])
+        return "holds" if ok else "fails"
+    gap = planar_gap(a, b)
     if rel in ACROSS_WORDS:
-        return planar_gap(a, b) <= ACROSS_M
-    return planar_gap(a, b) <= NEAR_M  # near and the view-dependent words
+        return "holds" if gap <= ACROSS_M else "fails"
+    reach = NEXT_TO if rel == "next to" else NEAR  # near and the view-dependent words
+    if gap <= reach:
+        return "holds"
+    return "marginal" if gap <= reach + BOX_NOISE_M else "fails"
 
 
 # ---------------------------------------------------------------------------------------- rooms
@@ -223,7 +243,7 @@ def ground(candidate: BoxLike, objects: Sequence[BoxLike], relations: Sequence[S
         status, line = _one(candidate, rel, obj, objects, relations, rooms, depth=0)
         statuses.append(status)
         evidence.append(f"{subject} {rel} {obj}: {status} ({line})")
-    status = "fails" if "fails" in statuses else ("unknown" if "unknown" in statuses else "holds")
+    status = next(s for s in ("fails", "unknown", "marginal", "holds") if s in statuses)
     return Grounding(candidate.id, status, tuple(evidence))
 
 
@@ -248,7 +268,8 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
     best = "fails"
     line = ""
     for other in sorted(others, key=lambda o: planar_gap(node, o)):
-        if not relation_holds(rel, node, other):
+        grade = relation_grade(rel, node, other)
+        if grade == "fails":
             continue
         if nested:
             sub = [_one(other, r, o2, objects, relations, rooms, depth=1)[0] for r, o2 in nested]
@@ -256,9 +277,15 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
                 line = f"#{other.id} is {rel} it, but not {', '.join(f'{r} {o2}' for r, o2 in nested)}"
                 continue
             if "unknown" in sub:
-                best, line = "unknown", f"#{other.id} is {rel} it; {', '.join(f'{r} {o2}' for r, o2 in nested)} unknown"
+                if best == "fails":
+                    best, line = "unknown", f"#{other.id} is {rel} it; {', '.join(f'{r} {o2}' for r, o2 in nested)} unknown"
                 continue
-        return "holds", f"#{other.id} at {planar_gap(node, other):.2f} m"
+            if "marginal" in sub:
+                grade = "marginal"
+        if grade == "holds":
+            return "holds", f"#{other.id} at {planar_gap(node, other):.2f} m"
+        if best != "marginal":
+            best, line = "marginal", f"#{other.id} at {planar_gap(node, other):.2f} m, within the boxes' noise margin only"
     if not line:
         line = f"nearest {obj} #{min(others, key=lambda o: planar_gap(node, o)).id} at " \
                f"{min(planar_gap(node, o) for o in others):.2f} m"

@@ -10,7 +10,12 @@ plausible one is not. This module ranks them; the reasoning node offers the firs
 hypothesis when the mission reports the search explored out (``ExploredOut``), and the mission
 verifies it (re-detection) like any other before it stops.
 
-Order: verdict "holds" (gated out by confidence or observations) before "unknown" before "fails";
+A relation that holds only within the memory boxes' noise margin ("marginal") does not confirm an
+instance either: the search goes on for ``reasoning.marginal_patience_s`` clock seconds, and the
+best marginal instance is offered then if no clearer one was confirmed (``due_marginal``).
+
+Order: verdict "holds" (gated out by confidence or observations) before "marginal" before
+"unknown" before "fails";
 then the detection evidence, confidence x observations; then the lower id (older node). Pure: no
 clocks, no I/O.
 """
@@ -24,10 +29,10 @@ from hiconav.reasoning.grounding import labels_match
 from hiconav.reasoning.hypothesis import TargetHypothesis
 from hiconav.reasoning.verifier import best_view
 
-__all__ = ["VERDICT_RANK", "best_unresolved", "unresolved_hypothesis"]
+__all__ = ["VERDICT_RANK", "best_unresolved", "due_marginal", "track_marginal", "unresolved_hypothesis"]
 
 # a verdict's place in the order (lower first); verdicts not listed are never offered
-VERDICT_RANK: dict[str, int] = {"holds": 0, "unknown": 1, "fails": 2}
+VERDICT_RANK: dict[str, int] = {"holds": 0, "marginal": 1, "unknown": 2, "fails": 3}
 
 
 def best_unresolved(objects: Sequence[Any], verdicts: Mapping[int, str], targets: Sequence[str],
@@ -45,8 +50,28 @@ def best_unresolved(objects: Sequence[Any], verdicts: Mapping[int, str], targets
                                     -float(o.confidence) * int(o.n_obs), int(o.id)))
 
 
+def track_marginal(since: Mapping[int, float], verdicts: Mapping[int, str], now: float) -> dict[int, float]:
+    """Object id -> the clock time (s) since which its verdict has been "marginal" without a
+    break: ids newly marginal start at ``now``, ids whose verdict changed are dropped."""
+    return {oid: float(since.get(oid, now)) for oid, v in verdicts.items() if v == "marginal"}
+
+
+def due_marginal(since: Mapping[int, float], now: float, patience_s: float,
+                 exclude: Collection[int] = ()) -> dict[int, str]:
+    """The marginal candidates whose patience ran out, as verdicts for ``unresolved_hypothesis``.
+
+    A relation that holds only within the memory boxes' noise margin (``grounding.relation_grade``)
+    may be the described one read through a box that stops short of its object, or the instance
+    beside it: the search goes on for ``patience_s`` clock seconds in case a clearly matching
+    instance shows up, and then the marginal one is offered rather than waiting for the whole
+    house to be explored (0: never offered before the search explores out)."""
+    if patience_s <= 0.0:
+        return {}
+    return {oid: "marginal" for oid, t0 in since.items() if now - t0 >= patience_s and oid not in exclude}
+
+
 def unresolved_hypothesis(memory: Any, verdicts: Mapping[int, str], targets: Sequence[str],
-                          exclude: Collection[int] = ()) -> TargetHypothesis | None:
+                          exclude: Collection[int] = (), why: str = "the search explored out") -> TargetHypothesis | None:
     """``best_unresolved`` on a memory snapshot (``objects``, ``anchors``) as a hypothesis: the
     anchor where the node's box is largest, confidence the node's detector confidence, source
     "offline" and evidence saying it is a fallback. None when no node qualifies or no anchor
@@ -61,7 +86,7 @@ def unresolved_hypothesis(memory: Any, verdicts: Mapping[int, str], targets: Seq
     anchor, bbox = view
     verdict = verdicts[int(node.id)]
     label = next((t for t in targets if labels_match(str(node.label), t)), str(node.label))
-    evidence = (f"offline fallback, the search explored out: object node {node.id} labelled "
+    evidence = (f"offline fallback, {why}: object node {node.id} labelled "
                 f"{node.label!r} is the best unresolved candidate (relations {verdict}, detector "
                 f"confidence {float(node.confidence):.2f}, seen {int(node.n_obs)} times)")
     return TargetHypothesis(anchor_id=int(anchor.id), object_id=int(node.id), bbox=bbox,

@@ -132,3 +132,37 @@ def test_explored_out_offers_the_best_unresolved_candidate_once_each():
     # nothing asked: nothing offered
     _tick(node, memory, 0.5)
     assert not [o for o in node.drain() if isinstance(o.msg, HypothesisMsg)]
+
+
+def test_a_marginal_candidate_is_offered_once_its_patience_runs_out():
+    import numpy as np
+
+    from hiconav.messages import HypothesisMsg
+
+    class _Verifier:
+        def verify(self, subgraph, task):
+            return SimpleNamespace(found=False, hypothesis=None, reason="relation_unknown", detail="",
+                                   latency_s=0.0, source="offline", verdicts={4: "marginal", 5: "unknown"})
+
+    node = ReasoningNode(parse=lambda text: text, make_reasoner=lambda task: _Queue(), verifier=_Verifier(),
+                         decompose=lambda memory, task, similarity, k=5: [], latency_s=0.0,
+                         marginal_patience_s=1.0)
+    node._set_task(SimpleNamespace(targets=("tv",), relations=(("tv", "next to", "sofa"),)))
+    objects = (SimpleNamespace(id=4, label="tv", confidence=0.4, n_obs=3),
+               SimpleNamespace(id=5, label="tv", confidence=0.9, n_obs=9))
+    anchors = (SimpleNamespace(id=1, object_ids=(4, 5), boxes=np.array([[0.1, 0.1, 0.3, 0.3], [0.5, 0.5, 0.9, 0.9]])),)
+    memory = SimpleNamespace(objects=objects, anchors=anchors, stamp=0.1)
+    offered = []
+    for k in range(1, 25):  # 0.1 s ticks: marginal since 0.1 s, due at 1.1 s
+        _tick(node, memory, round(0.1 * k, 1))
+        offered += [(round(0.1 * k, 1), o.msg.hypothesis.object_id) for o in node.drain()
+                    if isinstance(o.msg, HypothesisMsg) and o.dest == "mission"]
+    assert offered == [(1.1, 4)]  # once, the marginal one only (never the unknown one, however well seen)
+    assert [e["reason"] for e in node.events if e["kind"] == "unresolved"] == ["marginal"]
+    # without patience, a marginal candidate waits for the search to explore out
+    quiet = ReasoningNode(parse=lambda text: text, make_reasoner=lambda task: _Queue(), verifier=_Verifier(),
+                          decompose=lambda memory, task, similarity, k=5: [], latency_s=0.0)
+    quiet._set_task(SimpleNamespace(targets=("tv",), relations=(("tv", "next to", "sofa"),)))
+    for k in range(1, 25):
+        _tick(quiet, memory, round(0.1 * k, 1))
+    assert not [o for o in quiet.drain() if isinstance(o.msg, HypothesisMsg)]

@@ -9,7 +9,7 @@ import numpy as np
 
 from hiconav.reasoning.config import ReasoningConfig
 from hiconav.reasoning.decompose import decompose_instruction
-from hiconav.reasoning.grounding import ground, infer_rooms, planar_gap, relation_holds, room_of
+from hiconav.reasoning.grounding import ground, infer_rooms, planar_gap, relation_grade, relation_holds, room_of
 from hiconav.reasoning.verifier import FOUND, RELATION_UNKNOWN, OfflineVerifier
 
 
@@ -67,9 +67,44 @@ def test_next_to_is_a_planar_gap_of_about_a_metre():
     assert relation_holds("next to", a, b) and not relation_holds("next to", a, c)
     assert relation_holds("near", a, c)  # a 1.9 m gap
     assert not relation_holds("near", a, node(4, "floor_lamp", (3.0, 0)))  # 2.4 m
-    # a memory box's noise: a gap up to 0.1 m past the ground truth's metre still reads "next to"
+    # a memory box's noise: a gap up to 0.1 m past the ground truth's metre may still be "next to"
     assert relation_holds("next to", a, node(5, "floor_lamp", (1.5, 0), (0.3, 0.3)))  # 1.05 m
     assert not relation_holds("next to", a, node(6, "floor_lamp", (1.65, 0), (0.3, 0.3)))  # 1.2 m
+
+
+def test_a_relation_held_only_within_the_box_noise_is_marginal():
+    a = node(1, "armchair", (0, 0))
+    assert relation_grade("next to", a, node(2, "floor_lamp", (1.2, 0), (0.3, 0.3))) == "holds"  # 0.75 m
+    assert relation_grade("next to", a, node(3, "floor_lamp", (1.5, 0), (0.3, 0.3))) == "marginal"  # 1.05 m
+    assert relation_grade("next to", a, node(4, "floor_lamp", (1.65, 0), (0.3, 0.3))) == "fails"  # 1.2 m
+    assert relation_grade("near", a, node(5, "floor_lamp", (2.5, 0), (0.3, 0.3))) == "marginal"  # 2.05 m
+    # stacked: a painting over a chair whose box stops 0.05 m short of it holds; 0.25 m short,
+    # only within the pad a bed's box that stops short of its wall needs
+    painting = node(6, "painting", (0, 0.6), (0.8, 0.04), (1.2, 1.8))
+    near_chair = node(7, "chair", (0, 0.33), (0.5, 0.4), (0.0, 0.9))  # 0.05 m short
+    far_chair = node(8, "chair", (0, 0.13), (0.5, 0.4), (0.0, 0.9))  # 0.25 m short
+    assert relation_grade("under", near_chair, painting) == "holds"
+    assert relation_grade("below", far_chair, painting) == "marginal"
+    assert relation_grade("above", painting, far_chair) == "marginal"
+    assert relation_grade("under", node(9, "chair", (0, -0.3), (0.5, 0.4)), painting) == "fails"
+
+
+def test_a_marginal_relation_leaves_the_instance_unresolved_not_confirmed():
+    task = decompose_instruction("take me to the chair by the tv")
+    chair = node(1, "chair", (0, 0), (0.5, 0.5))
+    tv_far = node(2, "tv", (1.35, 0), (0.1, 0.8), (0.8, 1.4))  # 1.05 m: within the noise margin only
+    verifier = OfflineVerifier(ReasoningConfig())
+    result = verifier.verify(graph([chair, tv_far]), task)
+    assert not result.found and result.reason == RELATION_UNKNOWN and result.verdicts == {1: "marginal"}
+    assert "noise margin" in result.detail
+    # the tv 0.15 m nearer, within the words' own reach: confirmed
+    assert verifier.verify(graph([chair, node(2, "tv", (1.2, 0), (0.1, 0.8), (0.8, 1.4))]), task).found
+    # a clear instance is confirmed while a marginal one stands in the same view
+    other = node(3, "chair", (5, 0), (0.5, 0.5))
+    its_tv = node(4, "tv", (5.6, 0), (0.1, 0.8), (0.8, 1.4))  # 0.30 m from chair 3
+    result = verifier.verify(graph([chair, tv_far, other, its_tv]), task)
+    assert result.found and result.hypothesis.object_id == 3
+    assert result.verdicts == {1: "marginal", 3: "holds"}
 
 
 def test_on_means_resting_on_the_other_top_and_under_the_reverse():
