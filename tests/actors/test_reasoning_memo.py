@@ -100,23 +100,29 @@ def test_relations_that_fail_rule_instances_out_for_exploration_until_judged_aga
     assert [o.msg.object_ids for o in node.drain() if isinstance(o.msg, RuledOut)] == [frozenset({5})]
 
 
-def test_explored_out_offers_the_best_unresolved_candidate_once_each():
+def _two_tvs(verdicts: dict, relation: tuple, **kw) -> tuple[ReasoningNode, SimpleNamespace]:
+    """A reasoning node whose verifier always judges two tv nodes (4: seen 3 times at 0.4, 5: seen
+    9 times at 0.9) with ``verdicts``, and the memory holding them."""
     import numpy as np
-
-    from hiconav.messages import ExploredOut, HypothesisMsg
 
     class _Verifier:
         def verify(self, subgraph, task):
             return SimpleNamespace(found=False, hypothesis=None, reason="relation_unknown", detail="",
-                                   latency_s=0.0, source="offline", verdicts={4: "unknown", 5: "fails"})
+                                   latency_s=0.0, source="offline", verdicts=dict(verdicts))
 
     node = ReasoningNode(parse=lambda text: text, make_reasoner=lambda task: _Queue(), verifier=_Verifier(),
-                         decompose=lambda memory, task, similarity, k=5: [], latency_s=0.0)
-    node._set_task(SimpleNamespace(targets=("tv",), relations=(("tv", "in", "bedroom"),)))
+                         decompose=lambda memory, task, similarity, k=5: [], latency_s=0.0, **kw)
+    node._set_task(SimpleNamespace(targets=("tv",), relations=(relation,)))
     objects = (SimpleNamespace(id=4, label="tv", confidence=0.4, n_obs=3),
                SimpleNamespace(id=5, label="tv", confidence=0.9, n_obs=9))
     anchors = (SimpleNamespace(id=1, object_ids=(4, 5), boxes=np.array([[0.1, 0.1, 0.3, 0.3], [0.5, 0.5, 0.9, 0.9]])),)
-    memory = SimpleNamespace(objects=objects, anchors=anchors, stamp=0.1)
+    return node, SimpleNamespace(objects=objects, anchors=anchors, stamp=0.1)
+
+
+def test_explored_out_offers_the_best_unresolved_candidate_once_each():
+    from hiconav.messages import ExploredOut, HypothesisMsg
+
+    node, memory = _two_tvs({4: "unknown", 5: "fails"}, ("tv", "in", "bedroom"))
     _tick(node, memory, 0.1)
     node.drain()
 
@@ -135,23 +141,10 @@ def test_explored_out_offers_the_best_unresolved_candidate_once_each():
 
 
 def test_a_marginal_candidate_is_offered_once_its_patience_runs_out():
-    import numpy as np
-
     from hiconav.messages import HypothesisMsg
 
-    class _Verifier:
-        def verify(self, subgraph, task):
-            return SimpleNamespace(found=False, hypothesis=None, reason="relation_unknown", detail="",
-                                   latency_s=0.0, source="offline", verdicts={4: "marginal", 5: "unknown"})
-
-    node = ReasoningNode(parse=lambda text: text, make_reasoner=lambda task: _Queue(), verifier=_Verifier(),
-                         decompose=lambda memory, task, similarity, k=5: [], latency_s=0.0,
-                         marginal_patience_s=1.0)
-    node._set_task(SimpleNamespace(targets=("tv",), relations=(("tv", "next to", "sofa"),)))
-    objects = (SimpleNamespace(id=4, label="tv", confidence=0.4, n_obs=3),
-               SimpleNamespace(id=5, label="tv", confidence=0.9, n_obs=9))
-    anchors = (SimpleNamespace(id=1, object_ids=(4, 5), boxes=np.array([[0.1, 0.1, 0.3, 0.3], [0.5, 0.5, 0.9, 0.9]])),)
-    memory = SimpleNamespace(objects=objects, anchors=anchors, stamp=0.1)
+    verdicts, relation = {4: "marginal", 5: "unknown"}, ("tv", "next to", "sofa")
+    node, memory = _two_tvs(verdicts, relation, marginal_patience_s=1.0)
     offered = []
     for k in range(1, 25):  # 0.1 s ticks: marginal since 0.1 s, due at 1.1 s
         _tick(node, memory, round(0.1 * k, 1))
@@ -160,9 +153,7 @@ def test_a_marginal_candidate_is_offered_once_its_patience_runs_out():
     assert offered == [(1.1, 4)]  # once, the marginal one only (never the unknown one, however well seen)
     assert [e["reason"] for e in node.events if e["kind"] == "unresolved"] == ["marginal"]
     # without patience, a marginal candidate waits for the search to explore out
-    quiet = ReasoningNode(parse=lambda text: text, make_reasoner=lambda task: _Queue(), verifier=_Verifier(),
-                          decompose=lambda memory, task, similarity, k=5: [], latency_s=0.0)
-    quiet._set_task(SimpleNamespace(targets=("tv",), relations=(("tv", "next to", "sofa"),)))
+    quiet, memory = _two_tvs(verdicts, relation)
     for k in range(1, 25):
         _tick(quiet, memory, round(0.1 * k, 1))
     assert not [o for o in quiet.drain() if isinstance(o.msg, HypothesisMsg)]
