@@ -119,7 +119,8 @@ class ReasoningNode(Node):
         return subgraphs
 
     def _post_ruled_out(self, result: Any, now: float, delay: float) -> None:
-        """Tell exploration which target-category nodes the relations rule out, when that set
+        """Record the result's verdicts (and since when each marginal one has been marginal), and
+        tell exploration which target-category nodes the relations rule out, when that set
         changes (a later verdict that holds or is unknown takes a node back)."""
         self.verdicts.update(getattr(result, "verdicts", None) or {})
         self._marginal_since = track_marginal(self._marginal_since, self.verdicts, now)

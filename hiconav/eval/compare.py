@@ -27,11 +27,12 @@ from typing import Any
 
 from hiconav.errors import DataError
 from hiconav.eval.records import read_records
+from hiconav.eval.runner import EPISODES_FILE
 from hiconav.eval.stats import paired_comparison
 
 
 def _records(path: Path, preset: str | None) -> list[Any]:
-    file = path / "episodes.jsonl" if path.is_dir() else path
+    file = path / EPISODES_FILE if path.is_dir() else path
     if not file.is_file():
         raise DataError("no episode records here (an `hiconav eval` --out folder or its episodes.jsonl)",
                         file=str(path))

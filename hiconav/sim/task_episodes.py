@@ -26,8 +26,9 @@ goal's success region).
   clause strictly (the anchor is a visible landmark, its ProcTHOR parent *and* the geometry for
   "on", and the anchor stands in the described instance's room: a person by a painting on a
   bathroom wall does not call it "next to" the armchair on the wall's living room side, however
-  small the planar gap through the wall; ``GroundTruth.same_side``). The shortest description wins: room, one relation, room and relation, two relations;
-  an instance that no description singles out is not used.
+  small the planar gap through the wall; ``GroundTruth.same_side``). The shortest description
+  wins: room, one relation, room and relation, two relations; an instance that no description
+  singles out is not used.
 
 Generation is deterministic per (houses file line, task, n, seed). Reading checks each line
 (``parse_line``: fields; ``resolve``: object ids, start on the robot centre's free space, goal
