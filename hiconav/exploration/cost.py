@@ -34,7 +34,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from hiconav.exploration.config import CostConfig
 from hiconav.mapping.frontiers import nearest_reachable_cell
-from hiconav.mapping.occupancy import GridLike, lethal_mask
+from hiconav.mapping.occupancy import GridLike, lethal_mask, squeeze_mask
 from hiconav.types import Frontier, wrap_angle
 
 UNKNOWN = -1
@@ -60,13 +60,15 @@ class CostMatrix:
     h: np.ndarray
 
 
-def traversable_mask(grid: GridLike, config: CostConfig | None = None) -> np.ndarray:
+def traversable_mask(grid: GridLike, config: CostConfig | None = None, *, squeeze: bool = False) -> np.ndarray:
     """(H, W) bool cells the robot may cross: free (or unknown if configured) and clear of the robot
-    radius (``lethal_mask``: tight passages count, as the navigator may plan through them)."""
+    radius (``lethal_mask``: tight passages count, as the navigator may plan through them);
+    ``squeeze``: clear of the lethal layer one cell thinner (``squeeze_mask``, the navigator's last
+    resort)."""
     cfg = config or CostConfig()
     state = np.asarray(grid.state)
     ok = (state == 0) | (cfg.unknown_traversable & (state == UNKNOWN))
-    return ok & ~lethal_mask(grid)
+    return ok & ~(squeeze_mask(grid) if squeeze else lethal_mask(grid))
 
 
 def _coarsen(mask: np.ndarray, stride: int) -> np.ndarray:
@@ -87,13 +89,13 @@ def _coarsen(mask: np.ndarray, stride: int) -> np.ndarray:
     return out
 
 
-def coarse_traversable(grid: GridLike, config: CostConfig) -> np.ndarray:
+def coarse_traversable(grid: GridLike, config: CostConfig, *, squeeze: bool = False) -> np.ndarray:
     """The traversable mask coarsened by ``config.stride``: a coarse cell is traversable when any
     of its fine cells is and none is an obstacle. Passages one fine cell wide stay open (tight
     doorways, where only the robot radius is clear, look like that; an all-cells rule closed them
     and dropped every frontier behind them), and walls cannot leak: a coarse cell on a wall is
     blocked, and diagonal steps may not cut between two blocked coarse cells."""
-    trav = traversable_mask(grid, config)
+    trav = traversable_mask(grid, config, squeeze=squeeze)
     s = config.stride
     if s == 1:
         return trav
@@ -122,9 +124,11 @@ def _grid_graph(mask: np.ndarray, step: float) -> tuple[sp.csr_matrix, np.ndarra
     return g, node
 
 
-def geodesic_distances(grid: GridLike, points_xy: np.ndarray, config: CostConfig | None = None) -> np.ndarray:
-    """(k, k) geodesic metres between world points (k, 2) on the traversable grid; inf when
-    unreachable or off the grid. One Dijkstra call with all k sources (see module docstring)."""
+def geodesic_distances(grid: GridLike, points_xy: np.ndarray, config: CostConfig | None = None, *,
+                       squeeze: bool = False) -> np.ndarray:
+    """(k, k) geodesic metres between world points (k, 2) on the traversable grid (``squeeze``: see
+    ``traversable_mask``); inf when unreachable or off the grid. One Dijkstra call with all k
+    sources (see module docstring)."""
     cfg = config or CostConfig()
     pts = np.asarray(points_xy, dtype=float).reshape(-1, 2)
     k = pts.shape[0]
@@ -132,7 +136,7 @@ def geodesic_distances(grid: GridLike, points_xy: np.ndarray, config: CostConfig
     if k == 0:
         return out
     s = cfg.stride
-    coarse = coarse_traversable(grid, cfg)
+    coarse = coarse_traversable(grid, cfg, squeeze=squeeze)
     graph, node = _grid_graph(coarse, s * grid.resolution)
     rc = np.asarray(grid.world_to_cell(pts)) // s
     radius = math.ceil(cfg.snap_radius_m / (s * grid.resolution))
@@ -211,15 +215,17 @@ def travel_time(distance: np.ndarray, heading: np.ndarray, v_max: float, xi_dot_
 
 
 def cost_matrix(grid: GridLike, robot_xy: np.ndarray, robot_yaw: float, velocity_xy: np.ndarray,
-                frontiers: Sequence[Frontier], config: CostConfig | None = None) -> CostMatrix:
-    """The WTRP matrix M (eq. 20, 21) over the frontiers reachable from the robot."""
+                frontiers: Sequence[Frontier], config: CostConfig | None = None, *,
+                squeeze: bool = False) -> CostMatrix:
+    """The WTRP matrix M (eq. 20, 21) over the frontiers reachable from the robot (``squeeze``:
+    through passages only the lethal layer one cell thinner leaves open)."""
     cfg = config or CostConfig()
     robot_xy = np.asarray(robot_xy, float)[:2]
     n_all = len(frontiers)
     vps = np.array([np.asarray(f.viewpoint, float) for f in frontiers]).reshape(-1, 2)
     finite = np.all(np.isfinite(vps), axis=1) if n_all else np.zeros(0, bool)
     pts = np.vstack([robot_xy[None, :], np.where(finite[:, None], vps, robot_xy)])
-    D = geodesic_distances(grid, pts, cfg)
+    D = geodesic_distances(grid, pts, cfg, squeeze=squeeze)
     reach = np.flatnonzero(finite & np.isfinite(D[0, 1:]))
     kept = tuple(int(i) for i in reach)
     idx = np.concatenate([[0], reach + 1])

@@ -157,6 +157,11 @@ class ExplorationPlanner:
                  "s_vis": {i: float(v) for i, v in zip(ids, s_vis)}}
 
         cm = cost_matrix(grid, pose.xy, pose.yaw, np.asarray(velocity_xy, float), frontiers, self.config.cost)
+        if not cm.kept:
+            # no frontier is reachable on the lethal layer: the tracker keeps, as a last resort, those
+            # a passage one cell thinner reaches (``FrontierTracker``), and they are costed so too
+            cm = cost_matrix(grid, pose.xy, pose.yaw, np.asarray(velocity_xy, float), frontiers, self.config.cost,
+                             squeeze=True)
         kept = list(cm.kept)
         dropped = tuple(ids[i] for i in range(len(frontiers)) if i not in set(kept))
         M = cm.M

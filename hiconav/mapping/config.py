@@ -91,6 +91,10 @@ class FrontierConfig(BaseModel):
         True, description="drop frontiers with no viewpoint reachable from the robot"
     )
     robot_search_m: float = Field(0.5, ge=0.0, description="search radius for a free cell near the robot")
+    squeeze_fallback: bool = Field(
+        True, description="when no frontier has a reachable viewpoint, keep those reachable on the lethal "
+        "layer one cell thinner (a passage the map's noise closed by a cell)"
+    )
 
 
 class PoseGateConfig(BaseModel):

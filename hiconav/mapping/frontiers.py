@@ -18,7 +18,7 @@ import math
 import cv2
 import numpy as np
 
-from hiconav.mapping.occupancy import GridLike, lethal_mask
+from hiconav.mapping.occupancy import GridLike, lethal_mask, squeeze_mask
 from hiconav.mapping.config import FrontierConfig
 from hiconav.types import Frontier
 
@@ -82,6 +82,7 @@ class FrontierTracker:
         # whose cell (0, 0) is grid cell ``reachable_offset``
         self.reachable: np.ndarray | None = None
         self.reachable_offset = np.zeros(2, dtype=np.int64)
+        self.squeezed = False  # the last update's frontiers are reachable only one cell thinner
 
     @staticmethod
     def _global_keys(cells: np.ndarray, origin_cells: np.ndarray) -> np.ndarray:
@@ -134,6 +135,7 @@ class FrontierTracker:
         )
         reach = reachable_mask(traversable, start) if start is not None else traversable
         self.reachable, self.reachable_offset = reach, off
+        self.squeezed = False
         # a viewpoint must also see its frontier: same free-space component as the frontier cells
         _, free_labels = cv2.connectedComponents((state == 0).astype(np.uint8), connectivity=8)
 
@@ -142,7 +144,57 @@ class FrontierTracker:
         origin_cells = np.array([round(grid.origin[1] / res), round(grid.origin[0] / res)], dtype=np.int64)
         search = int(math.ceil(cfg.viewpoint_search_m / res))
 
-        clusters: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []  # cells, centroid_xy, viewpoint_xy
+        clusters = self._clusters(labels, stats, big, reach & roomy, reach, free_labels, search)
+        if not clusters and big and cfg.drop_unreachable and cfg.squeeze_fallback:
+            # no frontier has a viewpoint the robot reaches: the map's phase error and depth noise
+            # can close a passage the robot fits through by a cell (``squeeze_mask``), which ends
+            # the search with floor left unseen beyond it. The frontiers a viewpoint one cell
+            # thinner reaches are kept, as a last resort; the navigator squeezes toward them once
+            # the normal and tight plans fail.
+            squeeze = (state == 0) & ~squeeze_mask(grid)[r0:r1, c0:c1]
+            start_sq = nearest_reachable_cell(
+                squeeze, (int(rrc[0]), int(rrc[1])), int(math.ceil(cfg.robot_search_m / res))
+            )
+            if start_sq is not None:
+                reach_sq = reachable_mask(squeeze, start_sq)
+                clusters = self._clusters(labels, stats, big, reach_sq, reach_sq, free_labels, search)
+                self.squeezed = bool(clusters)
+        out_clusters: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        for cells, cen_rc, vp in clusters:
+            cells_full = (cells + off).astype(np.int32)
+            centroid = grid.cell_to_world(cen_rc + off)
+            viewpoint = (
+                grid.cell_to_world(np.array(vp, dtype=np.float64) + off)
+                if vp is not None
+                else np.full(2, np.nan)
+            )
+            out_clusters.append((cells_full, centroid, viewpoint))
+        clusters_w = out_clusters
+
+        ids = self._assign_ids(
+            [self._global_keys(c[0], origin_cells) for c in clusters_w], [c[1] for c in clusters_w]
+        )
+        out = [
+            Frontier(
+                id=fid,
+                centroid=np.asarray(cen, dtype=np.float64),
+                viewpoint=np.asarray(vp, dtype=np.float64),
+                size=int(cells.shape[0]),
+                cells=cells,
+            )
+            for fid, (cells, cen, vp) in zip(ids, clusters_w)
+        ]
+        out.sort(key=lambda f: f.id)
+        self.frontiers = out
+        return out
+
+    def _clusters(self, labels: np.ndarray, stats: np.ndarray, big: list[int], preferred: np.ndarray,
+                  reach: np.ndarray, free_labels: np.ndarray,
+                  search: int) -> list[tuple[np.ndarray, np.ndarray, tuple[int, int] | None]]:
+        """(cells, centroid (row, col), viewpoint cell or None) of each kept cluster piece, in the
+        crop's indexing: the viewpoint on ``preferred`` cells where one is near, else on ``reach``."""
+        cfg = self.config
+        clusters: list[tuple[np.ndarray, np.ndarray, tuple[int, int] | None]] = []
         for i in big:
             x, y, w, h = (
                 int(stats[i, k])
@@ -154,36 +206,13 @@ class FrontierTracker:
                 if cells.shape[0] < cfg.min_size_cells:
                     continue
                 cen_rc = cells.mean(axis=0)
-                vp = self._viewpoint(reach & roomy, free_labels, cells, cen_rc, search)
+                vp = self._viewpoint(preferred, free_labels, cells, cen_rc, search)
                 if vp is None:
                     vp = self._viewpoint(reach, free_labels, cells, cen_rc, search)
                 if vp is None and cfg.drop_unreachable:
                     continue
-                cells_full = (cells + off).astype(np.int32)
-                centroid = grid.cell_to_world(cen_rc + off)
-                viewpoint = (
-                    grid.cell_to_world(np.array(vp, dtype=np.float64) + off)
-                    if vp is not None
-                    else np.full(2, np.nan)
-                )
-                clusters.append((cells_full, centroid, viewpoint))
-
-        ids = self._assign_ids(
-            [self._global_keys(c[0], origin_cells) for c in clusters], [c[1] for c in clusters]
-        )
-        out = [
-            Frontier(
-                id=fid,
-                centroid=np.asarray(cen, dtype=np.float64),
-                viewpoint=np.asarray(vp, dtype=np.float64),
-                size=int(cells.shape[0]),
-                cells=cells,
-            )
-            for fid, (cells, cen, vp) in zip(ids, clusters)
-        ]
-        out.sort(key=lambda f: f.id)
-        self.frontiers = out
-        return out
+                clusters.append((cells, cen_rc, vp))
+        return clusters
 
     @staticmethod
     def _viewpoint(

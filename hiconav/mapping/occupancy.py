@@ -38,7 +38,7 @@ from hiconav.mapping.config import OccupancyConfig
 from hiconav.types import Frame, freeze
 
 __all__ = ["FREE", "OCCUPIED", "UNKNOWN", "GridSnapshot", "IntegrationStats", "OccupancyGrid", "disk_kernel",
-           "lethal_mask"]
+           "lethal_mask", "squeeze_mask"]
 
 UNKNOWN, FREE, OCCUPIED = -1, 0, 1
 
@@ -87,6 +87,32 @@ def lethal_mask(grid: GridLike) -> np.ndarray:
     without a ``lethal`` layer, e.g. hand-made test grids: then there are no tight passages)."""
     lethal = getattr(grid, "lethal", None)
     return np.asarray(grid.inflated if lethal is None else lethal, dtype=bool)
+
+
+def squeeze_mask(grid: GridLike) -> np.ndarray:
+    """(H, W) bool: the lethal layer one cell thinner (occupied cells grown by the lethal radius
+    less one cell), occupied cells kept; it only ever frees lethal cells.
+
+    The map marks an obstacle point on the cells within half a cell of it, so an occupied cell
+    reaches 0.5-1.5 cells past the surface depending on where the grid's lines fall, and the
+    lethal layer grows that by the robot radius less half a cell: in the scanned Gibson floors a
+    passage the robot fits through (0.45 m, robot 0.36 m) lost its last free cell to that phase
+    error, and a goal beyond it became unreachable. One cell less leaves the
+    robot a few centimetres too close at worst; the simulator slides it along the wall, as a
+    bumper-driven robot squeezes through a door.
+
+    The radius is measured on the layer itself (the farthest lethal cell from an occupied one), and
+    the thinner layer is grown again from the occupied cells: eroding the lethal layer instead
+    frees only its outer shell, so a corridor between two thick obstacles, where both sides'
+    lethal bands overlap, stayed closed."""
+    lethal = lethal_mask(grid)
+    occ = np.asarray(grid.state) == OCCUPIED
+    band = lethal & ~occ
+    if not occ.any() or not band.any():
+        return lethal | occ
+    dist = cv2.distanceTransform((~occ).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    radius = float(dist[band].max())
+    return occ | (lethal & (dist <= radius - 1.0 + 1e-3))
 
 
 class _OccupancyFields(GridFrame):

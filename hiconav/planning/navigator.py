@@ -19,7 +19,7 @@ import math
 import cv2
 import numpy as np
 
-from hiconav.mapping.occupancy import GridLike, lethal_mask
+from hiconav.mapping.occupancy import GridLike, lethal_mask, squeeze_mask
 from hiconav.geometry import ray_cast_grid
 from hiconav.mapping.frontiers import nearest_reachable_cell
 from hiconav.planning.astar import astar, smooth_path
@@ -40,22 +40,6 @@ def _finite_pose(pose: Pose2D) -> bool:
         return all(math.isfinite(float(v)) for v in (pose.x, pose.y, pose.yaw))
     except (AttributeError, TypeError, ValueError):
         return False
-
-
-def squeeze_mask(grid: GridLike) -> np.ndarray:
-    """(H, W) bool: the lethal layer shrunk by one cell (4-neighbour erosion), occupied cells kept.
-
-    The map marks an obstacle point on the cells within half a cell of it, so an occupied cell
-    reaches 0.5-1.5 cells past the surface depending on where the grid's lines fall, and the
-    lethal layer grows that by the robot radius less half a cell: in the scanned Gibson floors a
-    passage the robot fits through (0.45 m, robot 0.36 m) lost its last free cell to that phase
-    error, and a goal beyond it became unreachable. One cell less leaves the
-    robot a few centimetres too close at worst; the simulator slides it along the wall, as a
-    bumper-driven robot squeezes through a door."""
-    lethal = lethal_mask(grid).astype(np.uint8)
-    cross = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], dtype=np.uint8)
-    shrunk = cv2.erode(lethal, cross, borderType=cv2.BORDER_CONSTANT, borderValue=1).astype(bool)
-    return shrunk | (np.asarray(grid.state) == 1)
 
 
 def blocked_cells(grid: GridLike, *, through_unknown: bool = False, tight: bool = False,

@@ -285,3 +285,27 @@ def test_the_grid_grows_up_to_its_max_extent():
 def test_max_extent_below_the_first_grid_is_a_config_error():
     with pytest.raises(ValueError, match="initial_size_m"):
         OccupancyConfig(initial_size_m=12.0, max_extent_m=10.0)
+
+
+def test_the_squeeze_mask_opens_a_corridor_between_thick_obstacles():
+    """One cell thinner than the lethal layer, measured from the occupied cells: eroding the
+    lethal layer instead freed only its outer shell, and a corridor whose lethal bands overlap
+    from both sides (6 cells between two thick blocks, lethal radius 3.1 cells) stayed closed."""
+    from hiconav.mapping import GridSnapshot
+    from hiconav.mapping.occupancy import squeeze_mask
+
+    def grid(width: int) -> GridSnapshot:
+        s = np.zeros((40, 60), np.int8)
+        s[:, 20:40] = 1
+        s[17:17 + width, 20:40] = 0
+        occ = (s == 1).astype(np.uint8)
+        return GridSnapshot(state=s, inflated=cv2.dilate(occ, disk_kernel(4.6)).astype(bool),
+                            lethal=cv2.dilate(occ, disk_kernel(3.1)).astype(bool), explored=s != -1,
+                            origin=np.zeros(2), resolution=0.05, version=1, stamp=0.0)
+
+    wide, narrow = grid(6), grid(4)
+    assert wide.lethal[17:23, 20:40].all()  # the lethal layer closes the corridor
+    sq = squeeze_mask(wide)
+    assert not sq[19:21, 20:40].any() and sq[17, 20:40].all()  # its middle two rows open
+    assert sq[wide.state == OCCUPIED].all() and not (sq & ~wide.lethal).any()  # only lethal cells freed
+    assert squeeze_mask(narrow)[17:21, 20:40].all()  # two cells too narrow: closed
