@@ -25,6 +25,7 @@ from hiconav.messages import (
     GoalMsg,
     HealthAlert,
     HypothesisMsg,
+    KeyframeRequest,
     MissionFinished,
     NavStatus,
     ParseRequest,
@@ -37,7 +38,7 @@ from hiconav.messages import (
 )
 
 _ROUTES = {ParseRequest: "reasoning", GoalMsg: "control", StopRequest: "control", TargetRejected: "reasoning",
-           ExploredOut: "reasoning"}
+           ExploredOut: "reasoning", KeyframeRequest: "memory"}
 
 
 class MissionActor(NodeActor):

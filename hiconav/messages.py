@@ -100,6 +100,19 @@ class RuledOut:
 
 
 @dataclass(frozen=True)
+class KeyframeRequest:
+    """Mission -> Memory: make the frames up to clock time ``until`` visual anchors, one at least
+    every ``every_s`` seconds. Verification judges a candidate on anchors (keyframes); a robot that
+    stands and glances at it moves less than delta_d and turns less than delta_theta from its last
+    anchor, so the gate of eq. 2 alone makes none and the verdict waits for frames that only a
+    newly detected object (often a spurious one) would make."""
+
+    until: float
+    every_s: float = 0.0
+    stamp: float = 0.0
+
+
+@dataclass(frozen=True)
 class ExploredOut:
     """Mission -> Reasoning: the search has no frontier left and no confirmed target; the
     reasoning layer answers with a ``HypothesisMsg`` of its best unresolved candidate of a

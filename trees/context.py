@@ -22,7 +22,7 @@ import numpy as np
 
 from hiconav.decisions.config import DecisionsConfig
 from hiconav.geometry import footprint_distance
-from hiconav.messages import ExploredOut, GoalMsg, NavStatus, ParseRequest, StopRequest
+from hiconav.messages import ExploredOut, GoalMsg, KeyframeRequest, NavStatus, ParseRequest, StopRequest
 from hiconav.reasoning.grounding import target_relations
 from hiconav.types import Goal, Pose2D, TaskSpec
 
@@ -91,6 +91,7 @@ class MissionContext:
     rejections: list[tuple[int, str]] = field(default_factory=list)  # every rejection/deferral, in order
     start_pose: Pose2D | None = None
     outbox: list[Any] = field(default_factory=list)
+    keyframes_until: float | None = None  # clock time the newest KeyframeRequest covers
     goal_seq: int = 0
     active_goal: Goal | None = None
     stop_requested: bool = False
@@ -144,6 +145,15 @@ class MissionContext:
         """Tell the reasoning layer that the search has no frontier left (``ExploredOut``)."""
         self.unresolved_asks += 1
         self.outbox.append(ExploredOut(self.now()))
+
+    def request_keyframes(self, seconds: float, every_s: float = 0.0) -> None:
+        """Ask the memory layer to make the frames of the next ``seconds`` anchors, one at least every
+        ``every_s`` (``KeyframeRequest``); a request still covering that long is not repeated."""
+        until = self.now() + seconds
+        if self.keyframes_until is not None and self.keyframes_until >= until - seconds / 2.0:
+            return
+        self.keyframes_until = until
+        self.outbox.append(KeyframeRequest(until, every_s, self.now()))
 
     def send_goal(self, goal: Goal | None) -> int:
         """Ask the control layer to go to ``goal`` (None cancels); returns the request's seq."""

@@ -111,8 +111,10 @@ class VerifySettings(_Section):
     reposition_after: int = _f(4, "frames that could not show the candidate before trying another view cell",
                                1, 1000)
     view_cells: int = _f(3, "view cells tried before the candidate is deferred as hidden", 1, 100)
-    glance_deg: float = _f(35.0, "glances alternate this far left and right of facing the candidate: apart by "
-                                 "more than the memory's anchor gate, so each glance adds a frame", 0.0, 90.0)
+    glance_deg: float = _f(35.0, "glances alternate this far left and right of facing the candidate", 0.0, 90.0)
+    keyframe_every_s: float = _f(0.5, "while judging, the memory makes a frame an anchor this often (KeyframeRequest): "
+                                      "a robot glancing from one spot crosses no anchor gate", 0.0, 60.0)
+    keyframe_window_s: float = _f(2.0, "each keyframe request covers this long; renewed while judging", 0.1, 60.0)
     closer_moves: int = _f(2, "with no view cell on the map, drive toward the candidate this many times before "
                               "deferring it (0: defer at once)", 0, 100)
     closer_min_gain: float = _f(1.0, "a closer cell lies this much nearer the candidate's box than the robot (m)",

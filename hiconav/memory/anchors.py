@@ -27,7 +27,7 @@ __all__ = ["Anchor", "AnchorGate", "GateDecision", "downscale_image", "image_qua
 class GateDecision:
     """Outcome of the anchor gate for one frame (eq. 2).
 
-    reason: "first" | "new_object" | "translation" | "rotation" | "" (not an anchor);
+    reason: "first" | "new_object" | "translation" | "rotation" | "requested" | "" (not an anchor);
     translation (m) and rotation (rad) are measured against the last selected anchor.
     """
 
@@ -49,8 +49,11 @@ class AnchorGate:
         self.delta_theta = math.radians(delta_theta_deg)
         self.last_pose: Pose2D | None = None
 
-    def decide(self, pose: Pose2D, new_object: bool) -> GateDecision:
-        """Decision for a frame at base ``pose``; ``new_object`` is condition (i)."""
+    def decide(self, pose: Pose2D, new_object: bool, requested: bool = False) -> GateDecision:
+        """Decision for a frame at base ``pose``; ``new_object`` is condition (i); ``requested``: a
+        consumer asked for this frame as an anchor (``KeyframeRequest``: verification judges
+        anchors, and a robot glancing at a candidate from one spot moves less than delta_d and
+        turns less than delta_theta from its last anchor, so eq. 2 alone makes none)."""
         if self.last_pose is None:
             return GateDecision(True, "first", 0.0, 0.0)
         dt = pose.distance_to(self.last_pose)
@@ -61,6 +64,8 @@ class AnchorGate:
             return GateDecision(True, "translation", dt, dth)
         if dth > self.delta_theta:
             return GateDecision(True, "rotation", dt, dth)
+        if requested:
+            return GateDecision(True, "requested", dt, dth)
         return GateDecision(False, "", dt, dth)
 
     def accept(self, pose: Pose2D) -> None:

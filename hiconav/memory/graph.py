@@ -187,12 +187,13 @@ class CognitiveMemoryGraph:
         return None, float(s[j])
 
     # ------------------------------------------------------------------ update
-    def update(self, frame: Frame, detections: Sequence[Detection]) -> MemoryUpdate:
+    def update(self, frame: Frame, detections: Sequence[Detection], *, keyframe: bool = False) -> MemoryUpdate:
         """Integrate one frame and its detections (eqs. 2-4); returns what changed.
 
         frame: RGB-D frame with pose (``Frame``); detections: boxes (pixels), optional (H, W)
         masks and embeddings. Only frames selected as anchors change the graph (paper), unless
-        ``config.update_objects_every_frame``.
+        ``config.update_objects_every_frame``. ``keyframe``: a consumer asked for this frame as an
+        anchor (``AnchorGate.decide``'s ``requested``).
         """
         t0 = time.perf_counter()
         cfg = self.config
@@ -216,7 +217,7 @@ class CognitiveMemoryGraph:
         new_object = any(m is None for m in matches)
         if cfg.anchor_on_new_label and any(lab not in self._known_labels for lab in far):
             new_object = True
-        decision = self.gate.decide(frame.base_pose, new_object)  # eq. (2)
+        decision = self.gate.decide(frame.base_pose, new_object, requested=keyframe)  # eq. (2)
         self.stamp = float(frame.stamp)
 
         new_ids: list[int] = []

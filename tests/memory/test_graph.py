@@ -63,6 +63,32 @@ def test_gate_new_object_and_reference_is_last_selected_anchor():
     assert gate.decide(Pose2D(1.2, 0.0, 0.0), False).reason == "translation"
 
 
+def test_gate_makes_a_requested_frame_an_anchor_after_the_reasons_of_eq_2():
+    gate = AnchorGate()
+    gate.accept(Pose2D(0.0, 0.0, 0.0))
+    glance = Pose2D(0.0, 0.0, math.radians(30))  # a glance from one spot: no reason of eq. 2
+    assert not gate.decide(glance, False).is_anchor
+    assert gate.decide(glance, False, requested=True).reason == "requested"
+    assert gate.decide(Pose2D(0.0, 0.0, math.radians(50)), False, requested=True).reason == "rotation"
+
+
+def test_graph_makes_a_requested_frame_an_anchor_that_records_what_it_saw(embedder):
+    """Verification judges anchors: a robot glancing at a chair from one spot makes none by eq. 2,
+    so each frame it judges is asked for (``KeyframeRequest``); a frame that misses the chair is an
+    anchor too, and says so (its object ids do not include the chair's node)."""
+    g = graph(embedder)
+    boxes = [chair(3.0, 0.0)]
+    observe(g, Pose2D(0, 0, 0), boxes)
+    pose = Pose2D(0.0, 0.0, math.radians(25))
+    assert observe(g, pose, boxes, stamp=1).reason == ""
+    frame = render(pose, boxes, stamp=2)
+    seen = g.update(frame, detect(frame, boxes), keyframe=True)
+    missed = g.update(render(pose, boxes, stamp=3), [], keyframe=True)
+    assert seen.reason == missed.reason == "requested"
+    anchors = {a.id: a for a in g.snapshot().anchors}
+    assert anchors[seen.anchor_id].object_ids and not anchors[missed.anchor_id].object_ids
+
+
 def test_graph_gate_skips_frames_without_news(embedder):
     g = graph(embedder)
     boxes = [chair(3.0, 0.0)]

@@ -23,7 +23,8 @@ from hiconav.trees.registry import register_behaviour
 @register_behaviour()
 class VerifyTarget(_GoToObject):
     """Go within ``verify_distance`` of the candidate, facing it, and confirm it with fresh views,
-    glancing ``glance_deg`` left and right of it so that each glance makes an anchor. The state and
+    glancing ``glance_deg`` left and right of it; while it judges, the memory makes a frame an
+    anchor every ``keyframe_every_s`` (``MissionContext.request_keyframes``). The state and
     the next steps are ``verification.Verification``'s; a verdict rejects or defers the candidate
     (``MissionContext.reject``); a confirmed one is written as the target."""
 
@@ -116,6 +117,8 @@ class VerifyTarget(_GoToObject):
             return self._reject(flipped)
         gap, ring = ctx.distance_to_box(current.box_min, current.box_max), self._ring(current)
         judged = self._v.judge(self.settings, gap, ring, ctx.memory, ctx.grid, current, self._targets(), cand.label)
+        if self._v.judging:
+            ctx.request_keyframes(self.param("keyframe_window_s"), self.param("keyframe_every_s"))
         if judged is not None and not judged.confirmed:
             return self._reject(judged.verdict)
         if judged is not None:
