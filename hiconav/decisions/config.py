@@ -112,7 +112,7 @@ class VerifySettings(_Section):
                                1, 1000)
     view_cells: int = _f(3, "view cells tried before the candidate is deferred as hidden", 1, 100)
     glance_deg: float = _f(35.0, "glances alternate this far left and right of facing the candidate", 0.0, 90.0)
-    keyframe_every_s: float = _f(0.5, "while judging, the memory makes a frame an anchor this often (KeyframeRequest): "
+    keyframe_every_s: float = _f(1.0, "while judging, the memory makes a frame an anchor this often (KeyframeRequest): "
                                       "a robot glancing from one spot crosses no anchor gate", 0.0, 60.0)
     keyframe_window_s: float = _f(2.0, "each keyframe request covers this long; renewed while judging", 0.1, 60.0)
     closer_moves: int = _f(2, "with no view cell on the map, drive toward the candidate this many times before "
