@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
 from _exploration_fakes import FakeGrid, make_object, similarity
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "mapping"))
+from corridors import corridor_grid  # noqa: E402
 
 from hiconav.exploration import ExplorationConfig, ExplorationPlanner
 from hiconav.exploration.config import CostConfig, OrderingConfig, UtilityConfig
@@ -183,32 +188,11 @@ def test_ruled_out_instances_are_no_target_evidence() -> None:
     assert free.goal.id == A.id and free.s_struct[B.id] == 0.0
 
 
-def corridor(width: int):
-    """A closed room (x 0.5-2.0 m) whose east wall is a 2.5 m thick block with a corridor ``width``
-    cells (0.05 m) wide at y 1.35 m; the lethal layer (robot radius, 3.1 cells) closes any
-    corridor up to 7 cells wide, one cell thinner it opens 6 cells."""
-    import cv2
-
-    from hiconav.mapping import GridSnapshot
-    from hiconav.mapping.occupancy import disk_kernel
-
-    s = np.full((60, 120), -1, np.int8)
-    s[5:55, 5:45] = 1
-    s[10:50, 10:40] = 0
-    s[5:55, 40:90] = 1
-    s[27:27 + width, 40:90] = 0
-    s[15:45, 90:105] = 0
-    occ = (s == 1).astype(np.uint8)
-    return GridSnapshot(state=s, inflated=cv2.dilate(occ, disk_kernel(4.6)).astype(bool),
-                        lethal=cv2.dilate(occ, disk_kernel(3.1)).astype(bool), explored=s != -1,
-                        origin=np.zeros(2), resolution=0.05, version=1, stamp=0.0)
-
-
 def test_frontiers_reachable_only_one_cell_thinner_are_costed_so_when_nothing_else_is_reachable() -> None:
     """The tracker keeps such frontiers as a last resort (``FrontierTracker.squeezed``); costed on
     the lethal layer they were all dropped and the search ended with floor unseen."""
     far = Frontier(id=3, centroid=np.array([5.0, 1.5]), viewpoint=np.array([4.6, 1.5]), size=40)
-    out = planner().plan(corridor(6), [far], None, TASK, Pose2D(1.0, 1.5, 0.0), np.zeros(2), similarity, now=1.0)
+    out = planner().plan(corridor_grid(6), [far], None, TASK, Pose2D(1.0, 1.5, 0.0), np.zeros(2), similarity, now=1.0)
     assert out.goal is not None and out.goal.id == far.id and out.order == (far.id,)
-    out = planner().plan(corridor(4), [far], None, TASK, Pose2D(1.0, 1.5, 0.0), np.zeros(2), similarity, now=1.0)
+    out = planner().plan(corridor_grid(4), [far], None, TASK, Pose2D(1.0, 1.5, 0.0), np.zeros(2), similarity, now=1.0)
     assert out.goal is None and out.dropped == (far.id,)

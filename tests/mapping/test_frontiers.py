@@ -8,6 +8,8 @@ import numpy as np
 from hiconav.mapping import FrontierConfig, FrontierTracker, GridSnapshot, frontier_mask
 from hiconav.mapping.occupancy import disk_kernel
 
+from corridors import corridor_grid, snapshot
+
 RES = 0.05
 
 
@@ -137,23 +139,6 @@ def test_frontier_cells_are_free_and_touch_unknown():
     assert sum(f.size for f in fr) == int(m.sum())
 
 
-def corridor_grid(width: int) -> GridSnapshot:
-    """A closed room (rows 10..49, cols 10..39, 5-cell walls) whose east wall is a 2.5 m thick
-    block with a corridor ``width`` cells wide (rows 27..) into a free area seen beyond it (cols
-    90..104, unknown past them: its frontier lies farther than ``viewpoint_search_m`` from the
-    room). Lethal layer: the robot radius (3.1 cells); inflation 4.6 cells."""
-    s = np.full((60, 120), -1, np.int8)
-    s[5:55, 5:45] = 1
-    s[10:50, 10:40] = 0
-    s[5:55, 40:90] = 1
-    s[27:27 + width, 40:90] = 0
-    s[15:45, 90:105] = 0
-    occ = (s == 1).astype(np.uint8)
-    return GridSnapshot(state=s, inflated=cv2.dilate(occ, disk_kernel(4.6)).astype(bool),
-                        lethal=cv2.dilate(occ, disk_kernel(3.1)).astype(bool), explored=s != -1,
-                        origin=np.zeros(2), resolution=RES, version=1, stamp=0.0)
-
-
 def test_frontiers_beyond_a_passage_the_map_closes_by_a_cell_are_the_last_resort():
     """A corridor 6 cells (0.30 m) wide between thick obstacles: the lethal bands of both sides
     close it, one cell thinner it is open. Every frontier lies beyond it, so without the fallback
@@ -172,10 +157,7 @@ def test_a_squeezed_frontier_waits_while_another_is_reachable():
     s = corridor_grid(6).state.copy()
     s[20:26, 10] = 0  # an opening in the room's west wall toward the unknown outside
     s[20:26, 5:10] = 0
-    occ = (s == 1).astype(np.uint8)
-    grid = GridSnapshot(state=s, inflated=cv2.dilate(occ, disk_kernel(4.6)).astype(bool),
-                        lethal=cv2.dilate(occ, disk_kernel(3.1)).astype(bool), explored=s != -1,
-                        origin=np.zeros(2), resolution=RES, version=1, stamp=0.0)
+    grid = snapshot(s)
     tracker = FrontierTracker(FrontierConfig(min_size_cells=4))
     fr = tracker.update(grid, xy_of(grid, 30, 20))
     assert fr and not tracker.squeezed
