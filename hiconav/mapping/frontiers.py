@@ -5,8 +5,10 @@ A frontier cell is a free cell 4-adjacent to an unknown cell. Frontier cells are
 ones split along their principal axis, and each cluster gets a centroid and a viewpoint: the
 nearest free, non-inflated cell to the centroid that is connected to the robot through cells
 clear of the robot radius (tight passages count; see ``OccupancyGrid.lethal``), or the nearest
-such connected cell when none keeps the inflation margin. Ids stay stable across updates (and across grid growth) by matching clusters to the
-previous ones on shared global cells, then on centroid distance.
+such connected cell when none keeps the inflation margin; when no cluster has one, those reachable
+on the lethal layer one cell thinner are kept (``squeeze_fallback``). Ids stay stable across
+updates (and across grid growth) by matching clusters to the previous ones on shared global
+cells, then on centroid distance.
 
 It must not score or order frontiers (that is exploration's job) and must not modify the grid.
 """
@@ -159,7 +161,7 @@ class FrontierTracker:
                 reach_sq = reachable_mask(squeeze, start_sq)
                 clusters = self._clusters(labels, stats, big, reach_sq, reach_sq, free_labels, search)
                 self.squeezed = bool(clusters)
-        out_clusters: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        placed: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []  # cells, centroid_xy, viewpoint_xy
         for cells, cen_rc, vp in clusters:
             cells_full = (cells + off).astype(np.int32)
             centroid = grid.cell_to_world(cen_rc + off)
@@ -168,11 +170,10 @@ class FrontierTracker:
                 if vp is not None
                 else np.full(2, np.nan)
             )
-            out_clusters.append((cells_full, centroid, viewpoint))
-        clusters_w = out_clusters
+            placed.append((cells_full, centroid, viewpoint))
 
         ids = self._assign_ids(
-            [self._global_keys(c[0], origin_cells) for c in clusters_w], [c[1] for c in clusters_w]
+            [self._global_keys(c[0], origin_cells) for c in placed], [c[1] for c in placed]
         )
         out = [
             Frontier(
@@ -182,7 +183,7 @@ class FrontierTracker:
                 size=int(cells.shape[0]),
                 cells=cells,
             )
-            for fid, (cells, cen, vp) in zip(ids, clusters_w)
+            for fid, (cells, cen, vp) in zip(ids, placed)
         ]
         out.sort(key=lambda f: f.id)
         self.frontiers = out
