@@ -21,6 +21,7 @@ from hiconav.actors.node import Node
 from hiconav.actors.runtime import NodeActor
 from hiconav.errors import FrameError
 from hiconav.mapping.pose_gate import PoseGate, PoseJumpError
+from hiconav.memory import KeyframeSchedule
 from hiconav.messages import HypothesisMsg, KeyframeRequest, Observation, TaskMsg, WorldSnapshot
 
 log = logging.getLogger(__name__)
@@ -51,9 +52,8 @@ class MemoryNode(Node):
         self.latest_wins(Observation)
         self.on(HypothesisMsg, lambda m, now: self.hypotheses.append(m.hypothesis))
         self.on(TaskMsg, lambda m, now: setattr(self, "task", m.task))
-        self.keyframes: KeyframeRequest | None = None  # the newest request for anchors
-        self.last_requested: float | None = None  # clock time of the newest frame made an anchor on request
-        self.on(KeyframeRequest, lambda m, now: setattr(self, "keyframes", m))
+        self.keyframes = KeyframeSchedule()  # the frames the mission asked to be anchors
+        self.on(KeyframeRequest, lambda m, now: self.keyframes.request(m.until, m.every_s))
 
     def tick(self, now: float) -> None:
         obs = self.take(Observation)
@@ -69,7 +69,7 @@ class MemoryNode(Node):
         memory = None
         if self.cmg is not None:
             try:
-                self.cmg.update(obs.frame, list(obs.detections), keyframe=self._requested(now))
+                self.cmg.update(obs.frame, list(obs.detections), keyframe=self.keyframes.due(now))
             except FrameError as exc:  # the grid has the frame; only its objects are lost
                 self._drop("bad_frame", exc, obs)
             if self.prune_every and (self.seq + 1) % self.prune_every == 0:
@@ -78,17 +78,6 @@ class MemoryNode(Node):
         self.seq += 1
         self.emit(self.to, WorldSnapshot(self.seq, now, obs.frame.base_pose, self.grid.snapshot(), memory,
                                          int(obs.frame.seq)))
-
-    def _requested(self, stamp: float) -> bool:
-        """Whether the frame integrated at clock time ``stamp`` (the request's clock, not the
-        sensor's) is one a ``KeyframeRequest`` asks to be an anchor."""
-        req = self.keyframes
-        if req is None or stamp > req.until:
-            return False
-        if self.last_requested is not None and 0.0 <= stamp - self.last_requested < req.every_s:
-            return False
-        self.last_requested = stamp
-        return True
 
     def _drop(self, slot: str, exc: FrameError, obs: Observation) -> None:
         n = self.stats.dropped.get(slot, 0) + 1

@@ -5,7 +5,7 @@ set multicover ILP of eqs. (5)-(7), immutable snapshots for the other actors, an
 decomposition of eqs. (8)-(11) that the reasoner sends to a VLM. Pure and synchronous.
 """
 
-from hiconav.memory.anchors import AnchorGate, GateDecision
+from hiconav.memory.anchors import AnchorGate, GateDecision, KeyframeSchedule
 from hiconav.memory.config import MemoryConfig
 from hiconav.memory.graph import CognitiveMemoryGraph, MemoryUpdate, PruneResult
 from hiconav.memory.setcover import (
@@ -25,6 +25,7 @@ __all__ = [
     "AnchorView",
     "CognitiveMemoryGraph",
     "GateDecision",
+    "KeyframeSchedule",
     "MemoryConfig",
     "MemorySnapshot",
     "MemoryUpdate",

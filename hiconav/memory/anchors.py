@@ -20,7 +20,7 @@ import numpy as np
 from hiconav.memory.snapshot import AnchorView
 from hiconav.types import CameraIntrinsics, Frame, Pose2D, freeze, wrap_angle
 
-__all__ = ["Anchor", "AnchorGate", "GateDecision", "downscale_image", "image_quality"]
+__all__ = ["Anchor", "AnchorGate", "GateDecision", "KeyframeSchedule", "downscale_image", "image_quality"]
 
 
 @dataclass(frozen=True)
@@ -71,6 +71,29 @@ class AnchorGate:
     def accept(self, pose: Pose2D) -> None:
         """Record ``pose`` as the last selected anchor."""
         self.last_pose = pose
+
+
+class KeyframeSchedule:
+    """Which frames a consumer asked to be anchors (``KeyframeRequest``): those integrated up to
+    clock time ``until``, one at least every ``every_s`` seconds; the newest request replaces the
+    last. Times are the clock's (the request's), not the sensor's stamps."""
+
+    def __init__(self) -> None:
+        self.until: float | None = None
+        self.every_s = 0.0
+        self.last: float | None = None  # clock time of the newest frame made an anchor on request
+
+    def request(self, until: float, every_s: float = 0.0) -> None:
+        self.until, self.every_s = float(until), max(float(every_s), 0.0)
+
+    def due(self, now: float) -> bool:
+        """Whether the frame integrated at clock time ``now`` is one asked for (counted as made)."""
+        if self.until is None or now > self.until:
+            return False
+        if self.last is not None and 0.0 <= now - self.last < self.every_s:
+            return False
+        self.last = now
+        return True
 
 
 def downscale_image(rgb: np.ndarray, width: int, height: int) -> np.ndarray:

@@ -72,6 +72,17 @@ def test_gate_makes_a_requested_frame_an_anchor_after_the_reasons_of_eq_2():
     assert gate.decide(Pose2D(0.0, 0.0, math.radians(50)), False, requested=True).reason == "rotation"
 
 
+def test_keyframe_schedule_spaces_the_frames_asked_for_and_ends_with_the_request():
+    from hiconav.memory import KeyframeSchedule
+
+    ks = KeyframeSchedule()
+    assert not ks.due(0.0)  # nothing asked yet
+    ks.request(until=2.0, every_s=1.0)
+    assert [ks.due(t) for t in (0.5, 1.0, 1.5, 2.0, 2.5)] == [True, False, True, False, False]
+    ks.request(until=4.0, every_s=0.0)  # the newest request replaces the last
+    assert ks.due(3.0) and ks.due(3.0) and not ks.due(4.5)
+
+
 def test_graph_makes_a_requested_frame_an_anchor_that_records_what_it_saw(embedder):
     """Verification judges anchors: a robot glancing at a chair from one spot makes none by eq. 2,
     so each frame it judges is asked for (``KeyframeRequest``); a frame that misses the chair is an
