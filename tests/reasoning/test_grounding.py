@@ -89,6 +89,21 @@ def test_a_relation_held_only_within_the_box_noise_is_marginal():
     assert relation_grade("under", node(9, "chair", (0, -0.3), (0.5, 0.4)), painting) == "fails"
 
 
+def test_on_a_support_whose_box_stops_short_in_plan_is_marginal():
+    """A laptop on a dining table whose memory box stops 0.22 m short of it (the laptop hides
+    the top behind it, or the camera saw the top at a grazing angle): at the right height and
+    within the stack pad in plan it may be the support, not yet a failed relation."""
+    table = node(1, "dining_table", (0.0, 0.0), (1.2, 0.8), (0.0, 0.75))
+    on_top = node(2, "laptop", (0.3, 0.1), (0.35, 0.25), (0.75, 0.8))
+    past_edge = node(3, "laptop", (0.0, 0.655), (0.35, 0.25), (0.75, 0.8))  # 0.13 m past the box's edge
+    far = node(4, "laptop", (0.0, 1.05), (0.35, 0.25), (0.75, 0.8))  # 0.525 m past it
+    floor = node(5, "laptop", (0.3, 0.1), (0.35, 0.25), (0.0, 0.05))  # under it, on the floor
+    assert relation_grade("on", on_top, table) == "holds"
+    assert relation_grade("on", past_edge, table) == "marginal"
+    assert relation_grade("on", far, table) == "fails"
+    assert relation_grade("on", floor, table) == "fails"
+
+
 def test_a_marginal_relation_leaves_the_instance_unresolved_not_confirmed():
     task = decompose_instruction("take me to the chair by the tv")
     chair = node(1, "chair", (0, 0), (0.5, 0.5))
