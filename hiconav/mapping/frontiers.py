@@ -110,6 +110,7 @@ class FrontierTracker:
         ``grid``'s current indexing, centroid/viewpoint are world xy.
         """
         cfg = self.config
+        self.squeezed = False
         full_state = grid.state
         res = grid.resolution
         if full_state.size == 0 or not (full_state != -1).any():
@@ -137,7 +138,6 @@ class FrontierTracker:
         )
         reach = reachable_mask(traversable, start) if start is not None else traversable
         self.reachable, self.reachable_offset = reach, off
-        self.squeezed = False
         # a viewpoint must also see its frontier: same free-space component as the frontier cells
         _, free_labels = cv2.connectedComponents((state == 0).astype(np.uint8), connectivity=8)
 

@@ -144,9 +144,9 @@ def relation_grade(relation: str, a: BoxLike, b: BoxLike) -> str:
     it (planar gap within ``NEXT_TO`` / ``NEAR``, stacked boxes overlapping in plan within
     ``BOX_NOISE_M``, "on" with the upper box's centre over the lower one); "marginal" when it does
     so only within the memory boxes' noise margin (``NEXT_TO_M``, ``NEAR_M``, ``STACK_PAD_M``; for
-    "on", at the right height with the footprints within ``STACK_PAD_M``); else "fails". A marginal relation may be a true
-    one read through a box that stops short of its object, or a false one: the instance beside
-    the described one, a few centimetres past the words' reach."""
+    "on", at the right height with the footprints within ``STACK_PAD_M``); else "fails". A
+    marginal relation may be a true one read through a box that stops short of its object, or a
+    false one: the instance beside the described one, a few centimetres past the words' reach."""
     rel = relation.strip().lower()
     if rel == "on":
         if abs(float(a.box_min[2]) - float(b.box_max[2])) > ON_GAP_M:

@@ -291,17 +291,15 @@ def test_the_squeeze_mask_opens_a_corridor_between_thick_obstacles():
     """One cell thinner than the lethal layer, measured from the occupied cells: eroding the
     lethal layer instead freed only its outer shell, and a corridor whose lethal bands overlap
     from both sides (6 cells between two thick blocks, lethal radius 3.1 cells) stayed closed."""
-    from hiconav.mapping import GridSnapshot
+    from corridors import snapshot
+
     from hiconav.mapping.occupancy import squeeze_mask
 
-    def grid(width: int) -> GridSnapshot:
+    def grid(width: int):
         s = np.zeros((40, 60), np.int8)
         s[:, 20:40] = 1
         s[17:17 + width, 20:40] = 0
-        occ = (s == 1).astype(np.uint8)
-        return GridSnapshot(state=s, inflated=cv2.dilate(occ, disk_kernel(4.6)).astype(bool),
-                            lethal=cv2.dilate(occ, disk_kernel(3.1)).astype(bool), explored=s != -1,
-                            origin=np.zeros(2), resolution=0.05, version=1, stamp=0.0)
+        return snapshot(s)
 
     wide, narrow = grid(6), grid(4)
     assert wide.lethal[17:23, 20:40].all()  # the lethal layer closes the corridor
