@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from hiconav.decisions import last_resort as resort
 from hiconav.decisions.config import DecisionsConfig
 from hiconav.geometry import footprint_distance
 from hiconav.messages import ExploredOut, GoalMsg, KeyframeRequest, NavStatus, ParseRequest, StopRequest
@@ -89,6 +90,13 @@ class MissionContext:
     remaps: dict[int, int] = field(default_factory=dict)  # object id -> map deferrals so far
     max_remaps: int = 3  # map deferrals per candidate; later ones last their time
     rejections: list[tuple[int, str]] = field(default_factory=list)  # every rejection/deferral, in order
+    # object id -> the reason, for candidates whose latest rejection or deferral was only for want
+    # of a reachable view point or approach cell (``reject(out_of_reach=True)``): what an
+    # explored-out search may take back as its last resort (``hiconav.decisions.last_resort``)
+    out_of_reach: dict[int, str] = field(default_factory=dict)
+    # the candidate taken back as the last resort (None: none yet) and whether one was taken
+    last_resort: int | None = None
+    last_resort_taken: bool = False
     start_pose: Pose2D | None = None
     outbox: list[Any] = field(default_factory=list)
     keyframes_until: float | None = None  # clock time the newest KeyframeRequest covers
@@ -179,7 +187,10 @@ class MissionContext:
         ``requalify_observations`` observations and carries a target label again: a label that
         flipped once should not keep a real object waiting while the detector goes on reading it
         as the target. Only label flips requalify: an unreachable or unconfirmed
-        candidate is observed again at once from where the robot stands."""
+        candidate is observed again at once from where the robot stands. The last resort
+        (``take_last_resort``) is not excluded."""
+        if object_id == self.last_resort:
+            return False
         if object_id in self.rejected:
             return True
         if self.deferred.get(object_id, -1.0) <= self.now():
@@ -203,10 +214,18 @@ class MissionContext:
         return True
 
     def reject(self, object_id: int, reason: str, *, permanent: bool = True, defer_s: float = 30.0,
-               requalify: bool = False, remap: bool = False) -> None:
+               requalify: bool = False, remap: bool = False, out_of_reach: bool = False) -> None:
         """Verification failed: exclude the candidate for good, or for ``defer_s`` clock seconds
         (with ``requalify``, or until it is observed again as a target; with ``remap``, while
-        ``can_remap``, or until the map around it has grown: see ``excluded``)."""
+        ``can_remap``, or until the map around it has grown: see ``excluded``). ``out_of_reach``:
+        the reason is only that no view point or approach cell could be reached (the last
+        resort may take it back); any other reason clears that."""
+        if object_id == self.last_resort:
+            self.last_resort = None
+        if out_of_reach:
+            self.out_of_reach[object_id] = reason
+        else:
+            self.out_of_reach.pop(object_id, None)
         if permanent:
             self.rejected.add(object_id)
         else:
@@ -258,6 +277,10 @@ class MissionContext:
         objects = {o.id: o for o in memory.objects}
         out: list[Candidate] = []
         seen: set[int] = set()
+        if self.last_resort is not None and self.last_resort in objects:
+            seen.add(self.last_resort)
+            node = objects[self.last_resort]
+            out.append(self.candidate_of(node, resort.SOURCE, float(node.confidence)))
         for hyp in reversed(self.hypotheses):
             oid = self._resolve(hyp, memory, objects)
             if oid is None or oid in seen or self.excluded(oid):
@@ -278,6 +301,29 @@ class MissionContext:
                 matches.sort(key=lambda o: (-o.confidence * o.n_obs, o.id))
             out += [self.candidate_of(o, "memory-label", float(o.confidence)) for o in matches]
         return out
+
+    def take_last_resort(self) -> Candidate | None:
+        """Take back the best candidate set aside only as out of reach as the mission's last
+        resort, once (``hiconav.decisions.last_resort.pick``: the reasoning layer's first, then
+        the best seen); None when there is none."""
+        memory = self.memory
+        if memory is None or self.last_resort_taken:
+            return None
+        objects = {o.id: o for o in memory.objects}
+        confirmed = {oid for hyp in self.hypotheses if (oid := self._resolve(hyp, memory, objects)) is not None}
+        node = resort.pick(memory.objects, self.out_of_reach, confirmed)
+        if node is None:
+            return None
+        self.last_resort, self.last_resort_taken = int(node.id), True
+        self.log(f"last resort: #{node.id} ({node.label}), set aside as {self.out_of_reach[int(node.id)]!r}")
+        return self.candidate_of(node, resort.SOURCE, float(node.confidence))
+
+    @property
+    def stranded(self) -> bool:
+        """A candidate set aside only as out of reach is still in memory and no last resort was taken."""
+        memory = self.memory
+        return (not self.last_resort_taken and memory is not None
+                and any(int(o.id) in self.out_of_reach for o in memory.objects))
 
     @property
     def described(self) -> bool:

@@ -62,26 +62,36 @@ def gap(robot_xy: np.ndarray, box_min: np.ndarray, box_max: np.ndarray, points: 
     return Gap(float(rounded_box_distance(robot[0], robot[1], lo, hi, settings.corner_radius)), near)
 
 
-def rings(settings: ApproachSettings) -> list[float]:
+#: the spacing of a last resort's rings beyond the usual ones (m; ``rings(wide=True)``)
+WIDE_STEP_M = 0.5
+
+
+def rings(settings: ApproachSettings, wide: bool = False) -> list[float]:
     """The rings to look for an approach cell on (m from the footprint), inner first.
 
     Aim well inside the distance first; near walls and furniture the inflated map may only have
     free cells farther out, so widen the ring up to the distance itself. Furniture in front of
     the target (a sofa under a wall-mounted tv) can leave no free cell within the distance: then
     settle for the closest ring that has one, up to ``max_distance``, and stop there rather than
-    give up (the success check is the judge, not this estimate)."""
+    give up (the success check is the judge, not this estimate). ``wide``: a last resort
+    (``hiconav.decisions.last_resort``) goes on every ``WIDE_STEP_M`` out to ``last_resort_m``."""
     distance, inner, low = settings.distance, settings.inner_margin, settings.min_ring
     out = sorted({max(distance - inner, low), max(distance - min(inner, settings.second_margin), low), distance})
     out += [r for r in settings.settle_rings if distance < r <= settings.max_distance]
+    r = max(out) + WIDE_STEP_M
+    while wide and r <= settings.last_resort_m + 1e-9:
+        out.append(round(r, 6))
+        r += WIDE_STEP_M
     return out
 
 
-def ring_order(settings: ApproachSettings) -> list[RingTry]:
+def ring_order(settings: ApproachSettings, wide: bool = False) -> list[RingTry]:
     """The order of cell searches: cells that see the footprint past every wall on the rings out
     to ``strict_within`` (a cell behind a wall is never by the target; one a little farther that
     sees it may be); then any cell within the distance; then the rest, strict first. Beyond the
-    distance a ring's cell is the one nearest the object, not the robot (``settle_box_weight``)."""
-    distance, all_rings = settings.distance, rings(settings)
+    distance a ring's cell is the one nearest the object, not the robot (``settle_box_weight``).
+    ``wide``: with a last resort's rings (``rings``)."""
+    distance, all_rings = settings.distance, rings(settings, wide)
     order = [(True, r) for r in all_rings if r <= max(distance, settings.strict_within)]
     order += [(False, r) for r in all_rings if r <= distance]
     order += [(strict, r) for strict in (True, False) for r in all_rings
@@ -154,6 +164,19 @@ def face_goal(x: float, y: float, centre: np.ndarray, object_id: int, settings: 
     return Goal(x, y, facing(np.array([x, y]), centre), settings.face_tolerance, "look", object_id)
 
 
+def without_cell(gap_m: float, wide: bool, turned: bool, crept: bool, settings: ApproachSettings) -> str | None:
+    """What the approach does, ``gap_m`` from the object, where no ring had a cell: "creep" (a
+    ``creep_goal``), "face" (a ``face_goal``) or None (no reachable approach cell). A last resort
+    (``wide``; ``hiconav.decisions.last_resort``) stops where it stands: a creep toward the object
+    first when beyond the distance, then a turn to face it. Otherwise only a robot already within
+    the distance turns to face it, once (``turned``)."""
+    if wide and not (turned or crept):
+        return "creep" if gap_m > settings.distance and settings.creep else "face"
+    if gap_m <= settings.distance and not turned:
+        return "face"
+    return None
+
+
 def settled_beyond(ring: float, settings: ApproachSettings) -> bool:
     """Done on a ring wider than the distance: creep on toward the object (``creep``)."""
     return ring > settings.distance and settings.creep
@@ -183,5 +206,5 @@ def done(robot_xy: np.ndarray, yaw: float, gap_m: float, ring: float, cell: np.n
     return close and arrived and math.degrees(err) <= settings.facing_tolerance_deg
 
 
-__all__ = ["Gap", "RingTry", "creep_goal", "creeps_on", "done", "face_goal", "gap", "ring_order", "rings",
-           "settled_beyond", "straight_way_in"]
+__all__ = ["Gap", "RingTry", "WIDE_STEP_M", "creep_goal", "creeps_on", "done", "face_goal", "gap", "ring_order", "rings",
+           "settled_beyond", "straight_way_in", "without_cell"]

@@ -73,6 +73,9 @@ class ExploreSettings(_Section):
                              "navigator's thinner masks before giving up")
     unresolved_asks: int = _f(3, "explored out in search of a described instance, ask the reasoning layer this "
                                  "many times for its best unresolved candidate before failing", 0, 100)
+    last_resort: bool = _f(True, "explored out with a candidate set aside only as out of reach (no view point or "
+                                 "approach cell it could reach): stop as near the best of it as the map allows "
+                                 "rather than fail (hiconav.decisions.last_resort)")
 
 
 class VerifySettings(_Section):
@@ -180,6 +183,8 @@ class ApproachSettings(_Section):
     min_points: int = _f(10, "with measure 'points', a node with fewer points is measured by its box", 1, 100000)
     face_tolerance: float = _f(0.5, "the turn in place toward the target counts as reached this near where the "
                                     "robot stands (m)", 0.0, 5.0)
+    last_resort_m: float = _f(3.0, "a last resort (explore.last_resort) settles on rings out to this from the "
+                                   "footprint, else stops where it stands facing the target (m)", 0.0, 20.0)
 
 
 class ReturnSettings(_Section):

@@ -81,7 +81,9 @@ class ExploreLedger:
     ``squeezed_frontiers``, centroids pushed or squeezed into (world xy m); ``failed_frontiers``,
     ids of frontiers whose goal failed; ``unresolved_asks_left``: how many more times an
     explored-out search may ask the reasoning layer for its best unresolved candidate (0: never,
-    as for a task without a described instance).
+    as for a task without a described instance); ``last_resort_left``: how many more times an
+    explored-out search may take back a candidate set aside only as out of reach
+    (``hiconav.decisions.last_resort``; 0: none is left, or it was taken).
     """
 
     last_frontier_time: float
@@ -93,6 +95,7 @@ class ExploreLedger:
     failed_frontiers: set[int] = field(default_factory=set)
     squeezed_frontiers: list[Spot] = field(default_factory=list)
     unresolved_asks_left: int = 0
+    last_resort_left: int = 0
 
 
 @dataclass(frozen=True)
@@ -118,8 +121,10 @@ class FrontierGoal:
 class ExploreStep:
     """One tick's decision: the status, a feedback line, the goal to send (None: none), whether
     to cancel the goal in flight first, the lines to log in order, whether the deferred
-    candidates are due now (explored out: they are all that is left), and whether to ask the
-    reasoning layer for its best unresolved candidate (explored out, nothing deferred)."""
+    candidates are due now (explored out: they are all that is left), whether to ask the
+    reasoning layer for its best unresolved candidate (explored out, nothing deferred), and
+    whether to take back the best candidate set aside as out of reach (``last_resort``: explored
+    out, nothing deferred, nothing left to ask)."""
 
     status: Literal["running", "failure"]
     feedback: str
@@ -128,6 +133,7 @@ class ExploreStep:
     log: tuple[str, ...] = ()
     release_deferred: bool = False
     ask_unresolved: bool = False
+    last_resort: bool = False
     ended: bool = False  # the goal in flight ended (reached, failed or given up): forget it
 
 
@@ -411,6 +417,15 @@ class FrontierFollower:
                 log.append("no frontier left: asking the reasoning layer for its best unresolved candidate")
                 return ExploreStep("running", "no frontier left: asking for the best unresolved candidate",
                                    cancel=cancel, log=tuple(log), ask_unresolved=True)
+            if ledger.last_resort_left > 0 and s.last_resort:
+                # explored out, and a candidate was set aside only because no view point or approach
+                # cell could be reached: ending fails for certain, stopping as near it as the map
+                # allows may not (``hiconav.decisions.last_resort``)
+                ledger.last_resort_left -= 1
+                ledger.last_frontier_time = now
+                log.append("no frontier left: taking back the best candidate set aside as out of reach")
+                return ExploreStep("running", "no frontier left: the last resort", cancel=cancel, log=tuple(log),
+                                   last_resort=True)
             return ExploreStep("failure", "no frontier left", cancel=cancel, log=tuple(log))
         if pose is not None and (ledger.look_spot is None or
                                  math.hypot(pose.x - ledger.look_spot[0], pose.y - ledger.look_spot[1]) > s.look_spot_m):

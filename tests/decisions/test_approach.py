@@ -166,3 +166,14 @@ def test_done_without_a_cell_only_once_turned_toward_the_object():
     robot = np.array([3.7, 5.0])
     assert not plan.done(robot, 0.0, 0.8, 0.0, None, False, CENTRE, s)
     assert plan.done(robot, 0.0, 0.8, 0.0, None, True, CENTRE, s)
+
+
+def test_without_a_cell_a_last_resort_creeps_then_faces_and_others_face_only_within_the_distance():
+    s = ApproachSettings(distance=0.85)
+    assert plan.without_cell(2.0, True, False, False, s) == "creep"
+    assert plan.without_cell(0.5, True, False, False, s) == "face"
+    assert plan.without_cell(2.0, True, False, True, s) is None  # the creep ended: the behaviour faces
+    assert plan.without_cell(2.0, True, False, False, ApproachSettings(creep=False)) == "face"
+    assert plan.without_cell(2.0, False, False, False, s) is None  # no reachable approach cell
+    assert plan.without_cell(0.5, False, False, False, s) == "face"
+    assert plan.without_cell(0.5, False, True, False, s) is None

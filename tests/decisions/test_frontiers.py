@@ -184,3 +184,19 @@ def test_explored_out_asks_for_the_best_unresolved_candidate_while_asks_are_left
     ledger.unresolved_asks_left = 1
     step = f.step(None, Pose2D(0.0, 0.0, 0.0), 100.0, _plan(), ledger, {5: 130.0}, NO_START)
     assert step.release_deferred and not step.ask_unresolved and ledger.unresolved_asks_left == 1
+
+
+def test_explored_out_with_nothing_deferred_or_to_ask_the_last_resort_comes_once_before_failing():
+    f, ledger = FrontierFollower(), _ledger(last_frontier_time=0.0, last_resort_left=1)
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 100.0, _plan(), ledger, {}, NO_START)
+    assert step.status == "running" and step.last_resort and ledger.last_resort_left == 0
+    assert step.log == ("no frontier left: taking back the best candidate set aside as out of reach",)
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 100.0 + NO_START.max_idle_s + 1.0, _plan(), ledger, {}, NO_START)
+    assert step.status == "failure" and not step.last_resort
+    # after the deferred candidates and the reasoning layer's unresolved ones; never when turned off
+    ledger = _ledger(last_frontier_time=0.0, last_resort_left=1, unresolved_asks_left=1)
+    assert f.step(None, Pose2D(0.0, 0.0, 0.0), 100.0, _plan(), ledger, {5: 130.0}, NO_START).release_deferred
+    assert f.step(None, Pose2D(0.0, 0.0, 0.0), 200.0, _plan(), ledger, {}, NO_START).ask_unresolved
+    off = ExploreSettings(start_look_turns=0, last_resort=False)
+    assert f.step(None, Pose2D(0.0, 0.0, 0.0), 300.0, _plan(), ledger, {}, off).status == "failure"
+    assert f.step(None, Pose2D(0.0, 0.0, 0.0), 300.0, _plan(), ledger, {}, NO_START).last_resort

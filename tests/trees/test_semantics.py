@@ -1478,3 +1478,100 @@ def test_approach_inner_margin_sets_the_first_ring_and_centre_weight_pulls_to_th
     assert 4.5 - tied.x < 0.7  # the tie: deeper than the ring's edge
     deep = first_goal("distance: 0.9, inner_margin: 0.5")
     assert 4.5 - deep.x == pytest.approx(0.4, abs=0.06)
+
+
+LOCATE_THEN_STOP = """
+root:
+  Sequence:
+    memory: true
+    children:
+      - Retry:
+          num_failures: 50
+          child:
+            Sequence:
+              memory: true
+              children:
+                - Selector:
+                    memory: false
+                    children:
+                      - TargetConfirmed: {}
+                      - Explore: {max_idle_s: 3}
+                - VerifyTarget: {}
+                - Approach: {distance: 0.8}
+      - Stop: {}
+"""
+
+
+def _explored_out_with_a_bed_out_of_reach(tmp_path, reason_out_of_reach: bool, **decisions):
+    """A bed at (8, 8) on floor the map does not know, set aside (for good) as the robot at (2, 2)
+    found no view point of it; no frontier left."""
+    import numpy as np
+
+    from .fakes import FakeGrid
+
+    clock = Clock()
+    ctx = _ctx(clock, decisions=DecisionsConfig(explore=ExploreSettings(start_look_turns=0, **decisions)))
+    state = np.full((100, 100), -1, dtype=np.int8)
+    state[10:30, 10:30] = 0  # the robot's corner, 1-3 m
+    grid = FakeGrid(state, np.zeros_like(state, dtype=bool))
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 8.0, 8.0, n_obs=6)], grid=grid)
+    ctx.plan = plan()
+    ctx.reject(3, "no reachable view point" if reason_out_of_reach else "detected in 0 of 4 frames in view",
+               out_of_reach=reason_out_of_reach)
+    return clock, ctx, MissionTree(_write(tmp_path, LOCATE_THEN_STOP), ctx), grid
+
+
+def test_explored_out_the_mission_stops_by_the_candidate_it_set_aside_only_as_out_of_reach(tmp_path):
+    """Explored out, ending fails for certain: a candidate set aside only because no view point
+    could be reached is taken back once, taken as it is, and the robot stops as near it as the
+    map allows (here: nowhere nearer, so where it stands, facing it)."""
+    clock, ctx, tree, grid = _explored_out_with_a_bed_out_of_reach(tmp_path, True)
+    assert tree.tick() == S.RUNNING and ctx.last_resort is None
+    clock.t = 3.5
+    assert tree.tick() == S.RUNNING and ctx.last_resort == 3
+    assert any("last resort: #3" in e for e in ctx.events)
+    assert ctx.candidates()[0].source == "last-resort"
+    # no cell on the rings out to last_resort_m (the bed's floor is unknown): a creep through the
+    # unknown floor toward it, then a turn to face it where the creep ended
+    for _ in range(5):
+        tree.tick()
+    goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    assert goal.goal.ref_id == 3
+    if goal.goal.straight:  # the creep: blocked at once
+        ctx.nav = NavStatus(goal.seq, "failed", 0.0)
+        tree.tick()
+        goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    assert goal.goal.kind == "look"
+    ctx.world = world(Pose2D(2.0, 2.0, math.pi / 4), [obj(3, "bed", 8.0, 8.0, n_obs=6)], grid=grid)
+    ctx.nav = NavStatus(goal.seq, "reached", 0.0)
+    assert tree.tick() == S.SUCCESS
+    assert any(isinstance(m, StopRequest) for m in ctx.outbox)
+
+
+def test_explored_out_a_candidate_judged_wrong_is_no_last_resort_and_the_setting_turns_it_off(tmp_path):
+    for out_of_reach, on in ((False, True), (True, False)):
+        clock, ctx, tree, _ = _explored_out_with_a_bed_out_of_reach(tmp_path, out_of_reach, last_resort=on)
+        assert tree.tick() == S.RUNNING
+        clock.t = 3.5
+        ticks = 0
+        while tree.tick() == S.RUNNING:
+            ticks += 1
+            assert ticks < 60
+        assert tree.root.status == S.FAILURE and ctx.last_resort is None
+        assert not any(isinstance(m, StopRequest) for m in ctx.outbox)
+
+
+def test_a_later_rejection_on_evidence_clears_out_of_reach_and_a_last_resort_is_taken_once():
+    ctx = _ctx(Clock())
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 8.0, 8.0, n_obs=6), obj(4, "bed", 6.0, 2.0, n_obs=2)])
+    ctx.reject(3, "no reachable view point", out_of_reach=True)
+    ctx.reject(4, "approach: no reachable approach cell", permanent=False, out_of_reach=True)
+    assert ctx.stranded
+    ctx.reject(3, "detected in 0 of 4 frames in view")
+    assert set(ctx.out_of_reach) == {4}
+    cand = ctx.take_last_resort()
+    assert cand.object_id == 4 and cand.source == "last-resort" and not ctx.excluded(4)
+    assert ctx.take_last_resort() is None and not ctx.stranded  # once per mission
+    # rejected again (the approach timed out): it is no candidate any more
+    ctx.reject(4, "approach: timed out", permanent=True)
+    assert ctx.last_resort is None and ctx.excluded(4) and not ctx.candidates()

@@ -8,9 +8,12 @@ the straight way in or a creep, a turn to face the target); thresholds come from
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from hiconav.decisions import approach as plan
+from hiconav.decisions import last_resort as resort
 from hiconav.trees.behaviours.base import Status
 from hiconav.trees.behaviours.goto import _GoToObject
 from hiconav.trees.context import Candidate
@@ -21,7 +24,9 @@ from hiconav.trees.registry import register_behaviour
 class Approach(_GoToObject):
     """Reach a free cell within ``distance`` of the target's footprint (in front of its middle:
     ``centre_weight``), facing it. With no cell reachable or time run out, the target is deferred
-    (``defer_s``) before FAILURE, so that a Retry above explores on instead of picking it again."""
+    (``defer_s``) before FAILURE, so that a Retry above explores on instead of picking it again.
+    A last resort (``hiconav.decisions.last_resort``) tries rings out to ``last_resort_m``, then
+    stops where it stands, facing the target."""
 
     SETTINGS = "approach"
 
@@ -81,12 +86,16 @@ class Approach(_GoToObject):
         if self._seq is not None and self._cell is not None:
             self._excluded.append(self._cell)
         self._attempts += 1
-        for t in plan.ring_order(s) if self._attempts <= s.max_attempts else []:
+        wide = cand.source == resort.SOURCE
+        for t in plan.ring_order(s, wide) if self._attempts <= s.max_attempts else []:
             if self._send(cand, t.ring, strict_walls=t.strict, box_weight=t.box_weight):
                 self._ring = t.ring
                 return True
-        if ctx.pose is not None and self._gap(cand)[0] <= s.distance and not self._turned:
-            self._face(cand)
+        move = None if ctx.pose is None else plan.without_cell(self._gap(cand)[0], wide, self._turned, self._crept, s)
+        if move is not None:
+            self._ring = math.inf if wide else self._ring  # a last resort is done wherever it stops
+            if not (move == "creep" and self._creep(cand)):
+                self._face(cand)
             return True
         return ctx.grid is None or ctx.pose is None
 
@@ -127,7 +136,8 @@ class Approach(_GoToObject):
 
     def _give_up(self, cand: Candidate, why: str) -> Status:
         # no approach cell on this map: due again once the map around it has grown (as VerifyTarget)
+        unreachable = why == "no reachable approach cell"
         self.context.reject(cand.object_id, f"approach: {why}", permanent=False, defer_s=self.param("defer_s"),
-                            remap=why == "no reachable approach cell")
+                            remap=unreachable, out_of_reach=unreachable)
         self.feedback_message = why
         return Status.FAILURE

@@ -21,7 +21,8 @@ class Explore(MissionBehaviour):
 
     The decisions are ``FrontierFollower``'s (``hiconav.decisions.frontiers``): viewpoints facing
     their frontier, spent viewpoints skipped, a push into a spent frontier beside the robot, a
-    squeeze toward failed frontiers, the look-around turns, the idle clock. What must outlive one
+    squeeze toward failed frontiers, the look-around turns, the idle clock, the last resort of an
+    explored-out search (``hiconav.decisions.last_resort``). What must outlive one
     activation lives in the mission context (the idle clock ``last_frontier_time``, the start's
     and each spot's look counts, the spent / pushed / failed / squeezed spots), so a retried
     Explore goes on where a preempted one stopped, and one retried over an explored-out map
@@ -40,7 +41,7 @@ class Explore(MissionBehaviour):
         ctx = self.context
         ledger = ExploreLedger(ctx.last_frontier_time, ctx.start_looks, ctx.look_spot, ctx.looks_here,
                                ctx.spent_viewpoints, ctx.pushed_frontiers, ctx.failed_frontiers,
-                               ctx.squeezed_frontiers, self._asks_left())
+                               ctx.squeezed_frontiers, self._asks_left(), int(ctx.stranded))
         state = None if self._seq is None else ctx.nav_state(self._seq)
         step = self._follower.step(state, ctx.pose, ctx.now(), PlanView.of(ctx.plan), ledger, ctx.deferred,
                                    self.settings)
@@ -59,6 +60,8 @@ class Explore(MissionBehaviour):
             ctx.deferred.clear()
         if step.ask_unresolved:
             ctx.report_explored_out()
+        if step.last_resort:
+            ctx.take_last_resort()  # the next tick's TargetConfirmed takes it up
         self.feedback_message = step.feedback
         return Status.FAILURE if step.status == "failure" else Status.RUNNING
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from hiconav.decisions import confirmation as conf
+from hiconav.decisions import last_resort as resort
 from hiconav.decisions import verification as verif
 from hiconav.decisions import viewing as view
 from hiconav.trees.behaviours.base import Status
@@ -26,7 +27,7 @@ class VerifyTarget(_GoToObject):
     glancing ``glance_deg`` left and right of it; while it judges, the memory makes a frame an
     anchor every ``keyframe_every_s`` (``MissionContext.request_keyframes``). The state and
     the next steps are ``verification.Verification``'s; a verdict rejects or defers the candidate
-    (``MissionContext.reject``); a confirmed one is written as the target."""
+    (``MissionContext.reject``); a confirmed one, or a ``last_resort`` as it is, is the target."""
 
     SETTINGS, WRITES, READS = "verify", ("target",), ()
 
@@ -65,7 +66,7 @@ class VerifyTarget(_GoToObject):
         if self._cand is not None:
             ctx, oid = self.context, self._cand.object_id
             post = verif.posting(self.settings, verdict, oid, ctx.rejections, ctx.remaps.get(oid, 0), ctx.can_remap(oid))
-            ctx.reject(oid, verdict.reason, defer_s=self.param("defer_s"), **post.flags())
+            ctx.reject(oid, verdict.reason, defer_s=self.param("defer_s"), out_of_reach=verdict.remap, **post.flags())
         self.feedback_message = verdict.feedback
         return Status.FAILURE
 
@@ -108,6 +109,9 @@ class VerifyTarget(_GoToObject):
             self.feedback_message, status = (("no target to verify", Status.FAILURE) if cand is None else
                                              ("verification disabled: candidate accepted as is", Status.SUCCESS))
             return status
+        if cand.source == resort.SOURCE:  # no view point of it could be reached: no verification
+            self.feedback_message = f"last resort: {cand.label} #{cand.object_id} taken as it is"
+            return Status.SUCCESS
         if (obj := ctx.object(cand.object_id)) is None:
             return self._reject(conf.Verdict("rejected", "object node disappeared from memory"))
         if (switched := self._switch(obj, cand)) is not None:
