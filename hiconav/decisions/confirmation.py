@@ -236,6 +236,15 @@ def confirmed_node(tally: Tally, candidate_id: int) -> tuple[int, int] | None:
     return best
 
 
+def same_object(a_min: np.ndarray, a_max: np.ndarray, b_min: np.ndarray, b_max: np.ndarray) -> bool:
+    """Whether two nodes' boxes ((3,) world each) are one object seen twice rather than two side
+    by side: the footprint of either holds the other's centre."""
+    a_lo, a_hi = np.asarray(a_min, dtype=np.float64)[:2], np.asarray(a_max, dtype=np.float64)[:2]
+    b_lo, b_hi = np.asarray(b_min, dtype=np.float64)[:2], np.asarray(b_max, dtype=np.float64)[:2]
+    a_c, b_c = 0.5 * (a_lo + a_hi), 0.5 * (b_lo + b_hi)
+    return bool(np.all((a_lo <= b_c) & (b_c <= a_hi)) or np.all((b_lo <= a_c) & (a_c <= b_hi)))
+
+
 def for_good(settings: VerifySettings, permanent: bool, remap: bool, deferrals: int) -> bool:
     """Whether a verdict excludes the candidate for good: rejected, or deferred for the
     ``max_deferrals``-th time (``deferrals``: this one included; map deferrals, ``remap``, do not
@@ -249,5 +258,5 @@ def restart_unseen(tally: Tally) -> Tally:
 
 
 __all__ = ["Tally", "Verdict", "confirmed_node", "deferred", "detected_too_near", "evidence_verdict", "for_good",
-           "frames_since", "judge_frames", "label_verdict", "restart_unseen", "support_confidence", "support_ids",
-           "support_observations", "target_labels", "timeout_verdict"]
+           "frames_since", "judge_frames", "label_verdict", "restart_unseen", "same_object", "support_confidence",
+           "support_ids", "support_observations", "target_labels", "timeout_verdict"]

@@ -26,7 +26,7 @@ import numpy as np
 from hiconav.decisions.cells import camera_of, furniture_boxes, wall_heights
 from hiconav.decisions.config import VerifySettings
 from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, evidence_verdict, for_good, frames_since,
-                                            deferred, judge_frames, restart_unseen, support_ids,
+                                            deferred, judge_frames, restart_unseen, same_object, support_ids,
                                             target_labels, timeout_verdict)
 from hiconav.decisions.geometry import facing
 from hiconav.decisions.viewing import (ViewMove, blockers, close_distance, fallback_cell, nearer_candidate, next_view_move,
@@ -116,13 +116,17 @@ class Verification:
         return self.close or bool(self.tally.in_view)
 
     def judge(self, settings: VerifySettings, gap: float, ring: float, memory: Any, grid: Any, cand: Any,
-              task_targets: Iterable[str] | None, label: str) -> Judgement | None:
+              task_targets: Iterable[str] | None, label: str, described: bool = False) -> Judgement | None:
         """Whether the robot, ``gap`` m from the candidate's box, is close (``viewing.close_distance``
         for the view ring ``ring``); if so, judge the memory's anchors newer than the last judged
         (``confirmation.judge_frames``, against the ``memory`` snapshot's objects and the map
         ``grid``) for the candidate ``cand`` (its current box and observations; read as ``label``
         when it was chosen), and give the verdict of the frames so far (``evidence_verdict``);
-        None: judge on."""
+        None: judge on. A confirmed candidate hands on to the supporting node the fresh views
+        observed more often (``confirmation.confirmed_node``); for a ``described`` instance only
+        when that node is the same object seen again (``confirmation.same_object``): the
+        reasoning layer chose the candidate by its relations, and a neighbour of the same label
+        whose box touches it (chairs around a table) is another instance, not checked."""
         self.close = gap <= close_distance(settings, ring)
         if not self.close:
             return None
@@ -139,6 +143,8 @@ class Verification:
             return None if verdict is None else Judgement(verdict)
         found = confirmed_node(self.tally, cand.object_id)
         node = None if found is None else next((o for o in objects if o.id == found[0]), None)
+        if node is not None and described and not same_object(node.box_min, node.box_max, cand.box_min, cand.box_max):
+            node = None
         said = f"confirmed {cand.label} #{cand.object_id}: {verdict.reason}"
         if node is None:
             return Judgement(verdict, feedback=said)

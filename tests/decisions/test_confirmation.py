@@ -169,3 +169,11 @@ def test_the_max_deferrals_th_deferral_is_for_good_but_a_map_deferral_never_is()
 
 def test_a_new_cell_counts_the_frames_that_could_not_show_it_afresh():
     assert conf.restart_unseen(conf.Tally(in_view=2, unseen=5)) == conf.Tally(in_view=2)
+
+
+def test_two_boxes_are_one_object_when_either_footprint_holds_the_others_centre():
+    lo, hi = np.array([0.0, 0.0, 0.0]), np.array([1.0, 1.0, 1.0])
+    assert conf.same_object(lo, hi, lo + 0.4, hi + 0.4)  # overlapping by more than half
+    assert conf.same_object(lo, hi, np.array([0.4, 0.4, 0.0]), np.array([0.6, 0.6, 0.5]))  # a sliver inside
+    assert not conf.same_object(lo, hi, lo + [1.05, 0.0, 0.0], hi + [1.05, 0.0, 0.0])  # side by side
+    assert not conf.same_object(lo, hi, lo + 0.8, hi + 0.8)  # corners overlapping

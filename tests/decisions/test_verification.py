@@ -105,6 +105,19 @@ def test_a_supporting_node_the_fresh_views_observed_more_often_is_the_object_fou
     assert judged.log == "#1 confirmed by views of #8 (2 of them): going to #8"
 
 
+def test_a_described_instance_hands_on_only_to_the_same_object_seen_again_not_to_a_touching_neighbour():
+    """Chairs around a table: the neighbour whose box touches the candidate's (within the support
+    margin) is another instance, whose relations the reasoning layer never checked."""
+    for other_x, described, handed in ((6.05, True, False), (6.05, False, True), (5.3, True, True)):
+        v = verif.Verification(0.0)
+        other = node(8, "bed", other_x, 5.0)
+        memory = Memory([node(1, "bed", 5, 5), other], [facing_bed(10)])
+        v.judge(S, 1.0, RING, memory, None, BED, ["bed"], "bed", described)
+        memory.anchors += [facing_bed(11, (1, 8), ("bed",)), facing_bed(12, (8,), ("bed",))]
+        judged = v.judge(S, 1.0, RING, memory, None, BED, ["bed"], "bed", described)
+        assert judged is not None and judged.confirmed and (judged.node is other) == handed, (other_x, described)
+
+
 def test_frames_in_view_without_detections_reject_the_candidate():
     v = verif.Verification(0.0)
     memory = Memory([node(1, "bed", 5, 5)], [facing_bed(10)])

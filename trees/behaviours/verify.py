@@ -105,13 +105,12 @@ class VerifyTarget(_GoToObject):
 
     def update(self) -> Status:
         ctx, cand = self.context, self._cand
-        if cand is None or not ctx.verify:
-            self.feedback_message, status = (("no target to verify", Status.FAILURE) if cand is None else
-                                             ("verification disabled: candidate accepted as is", Status.SUCCESS))
+        if cand is None or not ctx.verify or cand.source == resort.SOURCE:  # a last resort had no view point
+            self.feedback_message, status = (
+                ("no target to verify", Status.FAILURE) if cand is None else
+                ("verification disabled: candidate accepted as is", Status.SUCCESS) if not ctx.verify else
+                (f"last resort: {cand.label} #{cand.object_id} taken as it is", Status.SUCCESS))
             return status
-        if cand.source == resort.SOURCE:  # no view point of it could be reached: no verification
-            self.feedback_message = f"last resort: {cand.label} #{cand.object_id} taken as it is"
-            return Status.SUCCESS
         if (obj := ctx.object(cand.object_id)) is None:
             return self._reject(conf.Verdict("rejected", "object node disappeared from memory"))
         if (switched := self._switch(obj, cand)) is not None:
@@ -120,7 +119,8 @@ class VerifyTarget(_GoToObject):
         if (flipped := conf.label_verdict(self._targets(), obj.label, cand.source)) is not None:
             return self._reject(flipped)
         gap, ring = ctx.distance_to_box(current.box_min, current.box_max), self._ring(current)
-        judged = self._v.judge(self.settings, gap, ring, ctx.memory, ctx.grid, current, self._targets(), cand.label)
+        judged = self._v.judge(self.settings, gap, ring, ctx.memory, ctx.grid, current, self._targets(), cand.label,
+                               ctx.described)
         if self._v.judging:
             ctx.request_keyframes(self.param("keyframe_window_s"), self.param("keyframe_every_s"))
         if judged is not None and not judged.confirmed:
