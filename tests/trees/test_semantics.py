@@ -62,6 +62,14 @@ def _approach_bed(tmp_path: Path, pose: Pose2D) -> tuple[MissionContext, Mission
     return ctx, tree, [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
 
 
+def _tick_while_running(tree: MissionTree, limit: int = 60) -> None:
+    """Tick on the same clock time until the tree stops RUNNING (at most ``limit`` ticks)."""
+    for _ in range(limit):
+        if tree.tick() != S.RUNNING:
+            return
+    raise AssertionError(f"still running after {limit} ticks")
+
+
 def _node(tree: MissionTree, name: str):
     return next(n for n in tree.root.iterate() if n.name == name)
 
@@ -523,10 +531,7 @@ def test_a_retried_explore_fails_at_once_when_the_map_is_explored_out(tmp_path):
                                         "      Explore: {max_idle_s: 3}\n"), ctx)
     assert tree.tick() == S.RUNNING
     clock.t = 3.5
-    ticks = 1
-    while tree.tick() == S.RUNNING:
-        ticks += 1
-        assert ticks < 60
+    _tick_while_running(tree)
     assert tree.root.status == S.FAILURE and clock.t == 3.5  # no simulated time spent idling again
 
 
@@ -1553,10 +1558,7 @@ def test_explored_out_a_candidate_judged_wrong_is_no_last_resort_and_the_setting
         clock, ctx, tree, _ = _explored_out_with_a_bed_out_of_reach(tmp_path, out_of_reach, last_resort=on)
         assert tree.tick() == S.RUNNING
         clock.t = 3.5
-        ticks = 0
-        while tree.tick() == S.RUNNING:
-            ticks += 1
-            assert ticks < 60
+        _tick_while_running(tree)
         assert tree.root.status == S.FAILURE and ctx.last_resort is None
         assert not any(isinstance(m, StopRequest) for m in ctx.outbox)
 
