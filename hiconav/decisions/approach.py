@@ -206,5 +206,5 @@ def done(robot_xy: np.ndarray, yaw: float, gap_m: float, ring: float, cell: np.n
     return close and arrived and math.degrees(err) <= settings.facing_tolerance_deg
 
 
-__all__ = ["Gap", "RingTry", "WIDE_STEP_M", "creep_goal", "creeps_on", "done", "face_goal", "gap", "ring_order", "rings",
-           "settled_beyond", "straight_way_in", "without_cell"]
+__all__ = ["Gap", "RingTry", "WIDE_STEP_M", "creep_goal", "creeps_on", "done", "face_goal", "gap", "ring_order",
+           "rings", "settled_beyond", "straight_way_in", "without_cell"]

@@ -10,8 +10,9 @@ mission takes that candidate back (``pick``), skips the verification it could no
 the approach settles for the reachable cell nearest it on rings out to ``last_resort_m``
 (``approach.rings(wide=True)``), or stops where it stands, facing it.
 
-Pure: memory objects, the mission's reasons of rejection and the settings in; a node or rings
-out. The ``Explore``, ``VerifyTarget`` and ``Approach`` behaviours poll this and post.
+Pure: memory objects and the mission's reasons of rejection in; a node out. The ``Explore``,
+``VerifyTarget`` and ``Approach`` behaviours poll this (and ``approach.rings``,
+``approach.without_cell``) and post.
 """
 
 from __future__ import annotations
