@@ -196,6 +196,15 @@ def footprint_gap(a_min: np.ndarray, a_max: np.ndarray, b_min: np.ndarray, b_max
     return math.hypot(dx, dy)
 
 
+def centre_in_footprint(a_min: np.ndarray, a_max: np.ndarray, b_min: np.ndarray, b_max: np.ndarray,
+                        pad: float = 0.0) -> bool:
+    """Whether the centre of box a's footprint lies in box b's footprint grown by ``pad`` m (both
+    axis-aligned boxes (3,) world, x and y used)."""
+    cx, cy = 0.5 * (float(a_min[0]) + float(a_max[0])), 0.5 * (float(a_min[1]) + float(a_max[1]))
+    return (float(b_min[0]) - pad <= cx <= float(b_max[0]) + pad
+            and float(b_min[1]) - pad <= cy <= float(b_max[1]) + pad)
+
+
 def aabb(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Axis-aligned bounding box (min (3,), max (3,)) of (N, 3) points, N >= 1."""
     points = np.asarray(points)

@@ -23,6 +23,7 @@ import numpy as np
 from hiconav.decisions.config import VerifySettings
 from hiconav.decisions.geometry import anchor_sees, wall_clear
 from hiconav.decisions.viewing import box_distance
+from hiconav.geometry import centre_in_footprint
 
 
 def target_labels(task_targets: Iterable[str] | None, label: str) -> set[str]:
@@ -239,10 +240,7 @@ def confirmed_node(tally: Tally, candidate_id: int) -> tuple[int, int] | None:
 def same_object(a_min: np.ndarray, a_max: np.ndarray, b_min: np.ndarray, b_max: np.ndarray) -> bool:
     """Whether two nodes' boxes ((3,) world each) are one object seen twice rather than two side
     by side: the footprint of either holds the other's centre."""
-    a_lo, a_hi = np.asarray(a_min, dtype=np.float64)[:2], np.asarray(a_max, dtype=np.float64)[:2]
-    b_lo, b_hi = np.asarray(b_min, dtype=np.float64)[:2], np.asarray(b_max, dtype=np.float64)[:2]
-    a_c, b_c = 0.5 * (a_lo + a_hi), 0.5 * (b_lo + b_hi)
-    return bool(np.all((a_lo <= b_c) & (b_c <= a_hi)) or np.all((b_lo <= a_c) & (a_c <= b_hi)))
+    return centre_in_footprint(a_min, a_max, b_min, b_max) or centre_in_footprint(b_min, b_max, a_min, a_max)
 
 
 def for_good(settings: VerifySettings, permanent: bool, remap: bool, deferrals: int) -> bool:

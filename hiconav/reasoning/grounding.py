@@ -35,7 +35,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from hiconav.geometry import footprint_gap
+from hiconav.geometry import centre_in_footprint, footprint_gap
 from hiconav.reasoning.decompose import CONTAINMENT
 from hiconav.reasoning.decompose import ROOMS as PARSER_ROOMS
 from hiconav.relations import NEAR, NEXT_TO
@@ -128,9 +128,7 @@ def _plan_overlap(a: BoxLike, b: BoxLike, pad: float = 0.05) -> bool:
 
 
 def _centre_in_plan(a: BoxLike, b: BoxLike, pad: float = 0.10) -> bool:
-    c = (np.asarray(a.box_min, float) + np.asarray(a.box_max, float)) / 2.0
-    b0, b1 = np.asarray(b.box_min, float), np.asarray(b.box_max, float)
-    return bool(b0[0] - pad <= c[0] <= b1[0] + pad and b0[1] - pad <= c[1] <= b1[1] + pad)
+    return centre_in_footprint(a.box_min, a.box_max, b.box_min, b.box_max, pad)
 
 
 def relation_holds(relation: str, a: BoxLike, b: BoxLike) -> bool:
