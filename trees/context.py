@@ -322,7 +322,7 @@ class MissionContext:
     def stranded(self) -> bool:
         """A candidate set aside only as out of reach is still in memory and no last resort was taken."""
         memory = self.memory
-        return (not self.last_resort_taken and memory is not None
+        return (bool(self.out_of_reach) and not self.last_resort_taken and memory is not None
                 and any(int(o.id) in self.out_of_reach for o in memory.objects))
 
     @property
