@@ -8,10 +8,11 @@ module's verdict says which armchair the words single out. It is the offline rea
 for a subgraph (the VLM path answers the same question from the subgraph's images).
 
 * **Rooms** are never read from a house's ground truth: each object node's room type is inferred
-  from the room-defining objects the robot saw with it (``ROOM_CUES``: a bed makes a bedroom, a
-  toilet a bathroom, a fridge a kitchen, a sofa a living room), weighted by a cue's strength and
-  by ``exp(-d / ROOM_DECAY_M)`` of its planar distance, counted only for nodes observed from a
-  common anchor (co-visible objects share a room far more often than objects behind a wall).
+  from the objects the robot saw with it, as a naive-Bayes posterior whose likelihoods were
+  counted in the ProcTHOR *training* houses (``room_prior``: a bed says bedroom, a sink bathroom,
+  an armchair bedroom or living room), each cue weighted by ``exp(-d / ROOM_DECAY_M)`` of its
+  planar distance and counted only for nodes observed from a common anchor (co-visible objects
+  share a room far more often than objects behind a wall).
 * **Relations** are predicates on axis-aligned boxes (world metres): ``next to`` a planar gap of
   at most ``NEXT_TO_M``, ``near`` at most ``NEAR_M``, ``on`` resting on the other's top, ``under``
   and ``above`` overlapping in plan one below the other, ``facing`` / ``opposite`` at most
@@ -29,7 +30,7 @@ functions; no I/O, no clocks.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -38,6 +39,7 @@ import numpy as np
 from hiconav.geometry import centre_in_footprint, footprint_gap
 from hiconav.reasoning.decompose import CONTAINMENT
 from hiconav.reasoning.decompose import ROOMS as PARSER_ROOMS
+from hiconav.reasoning.room_prior import ROOMS, default_log_ratios
 from hiconav.relations import NEAR, NEXT_TO
 from hiconav.types import label_key
 
@@ -63,9 +65,8 @@ ON_GAP_M = 0.30
 STACK_PAD_M = 0.30
 ROOM_DECAY_M = 2.5  # m: a room cue's weight falls by e over this planar distance
 ROOM_REACH_M = 6.0  # m: cues farther than this say nothing of an object's room
-ROOM_MIN_SCORE = 0.8  # below this evidence the room is unknown
-
-ROOMS: tuple[str, ...] = ("bedroom", "bathroom", "kitchen", "living_room")
+# below this posterior the room is unknown (chosen on ProcTHOR train textnav, seeds 0 and 1)
+ROOM_MIN_POSTERIOR = 0.7
 # Aliases people use for the four room types (the parser maps them to these labels or keeps them).
 ROOM_ALIASES: dict[str, str] = {
     "bedroom": "bedroom", "bed_room": "bedroom", "master_bedroom": "bedroom", "guest_room": "bedroom",
@@ -74,23 +75,6 @@ ROOM_ALIASES: dict[str, str] = {
     "kitchen": "kitchen", "kitchenette": "kitchen",
     "living_room": "living_room", "livingroom": "living_room", "lounge": "living_room",
     "sitting_room": "living_room", "family_room": "living_room", "den": "living_room",
-}
-# category -> ((room, weight), ...): how strongly seeing it says which room one is in.
-ROOM_CUES: dict[str, tuple[tuple[str, float], ...]] = {
-    "bed": (("bedroom", 3.0),), "dresser": (("bedroom", 1.5),), "alarm_clock": (("bedroom", 1.0),),
-    "desk": (("bedroom", 0.7),), "desk_lamp": (("bedroom", 0.5),), "laundry_hamper": (("bedroom", 0.5), ("bathroom", 0.5)),
-    "teddy_bear": (("bedroom", 0.7),),
-    "toilet": (("bathroom", 3.0),), "bathtub": (("bathroom", 3.0),), "shower": (("bathroom", 3.0),),
-    "shower_curtain": (("bathroom", 2.0),), "toilet_paper": (("bathroom", 2.0),), "towel_holder": (("bathroom", 1.5),),
-    "hand_towel": (("bathroom", 1.0),), "plunger": (("bathroom", 2.0),), "soap_bar": (("bathroom", 1.0),),
-    "fridge": (("kitchen", 3.0),), "oven": (("kitchen", 3.0),), "stove": (("kitchen", 3.0),),
-    "stove_burner": (("kitchen", 3.0),), "microwave": (("kitchen", 2.0),), "coffee_machine": (("kitchen", 2.0),),
-    "toaster": (("kitchen", 2.0),), "dishwasher": (("kitchen", 2.0),), "counter_top": (("kitchen", 1.5),),
-    "sink": (("kitchen", 1.0), ("bathroom", 1.0)), "kettle": (("kitchen", 1.0),), "pan": (("kitchen", 1.0),),
-    "pot": (("kitchen", 1.0),), "garbage_can": (("kitchen", 0.3),),
-    "sofa": (("living_room", 3.0),), "tv_stand": (("living_room", 2.0),), "coffee_table": (("living_room", 2.0),),
-    "tv": (("living_room", 1.5),), "armchair": (("living_room", 1.5),), "floor_lamp": (("living_room", 0.7),),
-    "ottoman": (("living_room", 1.0),), "dining_table": (("living_room", 0.5), ("kitchen", 0.5)),
 }
 # room types the instruction parser knows that no room cue infers (dining room, hallway, office,
 # laundry room, garage): the ProcTHOR houses have none of them, and the objects that furnish them
@@ -175,22 +159,30 @@ def relation_grade(relation: str, a: BoxLike, b: BoxLike) -> str:
 
 
 # ---------------------------------------------------------------------------------------- rooms
-def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = ()) -> dict[int, tuple[str | None, float]]:
-    """Object id -> (inferred room type or None, its evidence score) for every object.
+def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = (),
+                cues: Mapping[str, Mapping[str, float]] | None = None) -> dict[int, tuple[str | None, float]]:
+    """Object id -> (inferred room type or None, its posterior) for every object.
 
-    An object's room scores sum, over the objects co-visible with it (a common anchor) within
-    ``ROOM_REACH_M`` and over itself, each cue weight x exp(-gap / ROOM_DECAY_M). Objects whose
-    label is in ``ignore`` give no cue: for "the tv in the bedroom" the tvs are what the
-    description tells apart, so a tv's own "living room" cue must not decide which room it is in."""
+    A naive-Bayes posterior over ``ROOMS`` from a uniform prior: every object co-visible with it
+    (a common anchor) within ``ROOM_REACH_M``, and itself, adds its category's log-likelihood
+    ratios (``cues``; default: learnt from the ProcTHOR training houses, ``room_prior``) weighted
+    by exp(-gap / ROOM_DECAY_M). The most probable room is inferred when its posterior reaches
+    ``ROOM_MIN_POSTERIOR``, else None; None with 0.0 when no object with a cue was seen with it.
+    Objects whose label is in ``ignore`` give no cue: for "the tv in the bedroom" the tvs are
+    what the description tells apart, so a tv's own lean to the living room must not decide
+    which room it is in."""
+    table = default_log_ratios() if cues is None else cues
     out: dict[int, tuple[str | None, float]] = {}
     # co-visibility: a common anchor, pruned ones included where the node keeps them (observed_by)
     anchors = {o.id: set(getattr(o, "observed_by", ()) or getattr(o, "anchor_ids", ()) or ()) for o in objects}
     skip = {label_key(str(t)) for t in ignore}
     for o in objects:
-        scores: dict[str, float] = {}
+        logit = dict.fromkeys(ROOMS, 0.0)
+        seen = False
         for other in objects:
-            cues = ROOM_CUES.get(other.label)
-            if not cues or label_key(other.label) in skip:
+            key = label_key(str(other.label))
+            ratios = table.get(key)
+            if not ratios or key in skip:
                 continue
             if other.id != o.id and not (anchors[o.id] & anchors[other.id]):
                 continue
@@ -198,13 +190,17 @@ def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = ()) -> dict[
             if gap > ROOM_REACH_M:
                 continue
             w = math.exp(-gap / ROOM_DECAY_M)
-            for room, weight in cues:
-                scores[room] = scores.get(room, 0.0) + weight * w
-        if not scores:
+            seen = True
+            for room in ROOMS:
+                logit[room] += w * float(ratios.get(room, 0.0))
+        if not seen:
             out[o.id] = (None, 0.0)
             continue
-        room, score = max(scores.items(), key=lambda kv: (kv[1], kv[0]))
-        out[o.id] = (room if score >= ROOM_MIN_SCORE else None, score)
+        top = max(logit.values())
+        z = sum(math.exp(v - top) for v in logit.values())
+        room, v = max(logit.items(), key=lambda kv: (kv[1], kv[0]))
+        p = math.exp(v - top) / z
+        out[o.id] = (room if p >= ROOM_MIN_POSTERIOR else None, p)
     return out
 
 
@@ -256,14 +252,15 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
          rooms: dict[int, tuple[str | None, float]], depth: int) -> tuple[str, str]:
     room = room_of(obj)
     if room is None and label_key(obj) in UNINFERRED_ROOMS:
-        # "the table in the dining room": a room type no cue of ROOM_CUES tells apart; waiting
+        # "the table in the dining room": a room type the room prior does not tell apart; waiting
         # for its evidence would hold the search forever, so the words are not checked
         return "holds", f"a {obj.replace('_', ' ')} is no room type the map infers (not checked)"
     if room is not None and rel.strip().lower() in CONTAINMENT:
         seen, score = rooms.get(node.id, (None, 0.0))
         if seen is None:
-            return "unknown", "no room cue seen with it"
-        return ("holds" if seen == room else "fails"), f"inferred {seen} (evidence {score:.1f})"
+            return "unknown", ("no room cue seen with it" if score <= 0.0 else
+                               f"no room clear enough (p {score:.2f} < {ROOM_MIN_POSTERIOR:g})")
+        return ("holds" if seen == room else "fails"), f"inferred {seen} (p {score:.2f})"
     others = [o for o in objects if o.id != node.id and labels_match(o.label, obj)]
     if not others:
         return "unknown", f"no {obj} in view"

@@ -154,7 +154,8 @@ def test_a_room_is_inferred_from_the_objects_seen_with_it_not_through_walls():
     assert rooms[1][0] == "bedroom"
     assert rooms[3][0] == "kitchen"
     lonely = node(4, "chair", (10, 10), anchors=(3,))
-    assert infer_rooms([lonely, bed])[4] == (None, 0.0)
+    assert infer_rooms([lonely, bed])[4][0] is None  # a chair alone stands in any room
+    assert infer_rooms([node(5, "hovercraft", (0, 0))])[5] == (None, 0.0)  # no category with a cue
 
 
 # ---------------------------------------------------------------------------------- verdicts
@@ -296,7 +297,9 @@ def test_the_described_category_gives_no_room_cue_of_its_own():
     suggests."""
     scene = [node(1, "tv", (0, 0), (1.0, 0.3), (0.5, 1.2)), node(2, "dresser", (0, 1.0), (1.2, 0.5))]
     task = decompose_instruction("take me to the tv in the bedroom", ReasoningConfig(), similarity=None)
-    assert infer_rooms(scene)[1][0] == "living_room"  # by its own cue
+    cues = {"tv": {"living_room": 5.0}, "dresser": {"bedroom": 3.0}}  # a tv leaning hard to living rooms
+    assert infer_rooms(scene, cues=cues)[1][0] == "living_room"  # by its own cue
+    assert infer_rooms(scene, ignore=("tv",), cues=cues)[1][0] == "bedroom"
     assert infer_rooms(scene, ignore=("tv",))[1][0] == "bedroom"
     assert ground(scene[0], scene, task.relations, task.targets).status == "holds"
 
