@@ -63,6 +63,12 @@ ON_GAP_M = 0.30
 # bed or sofa that stands against the same wall has its memory box on the wall's face, the
 # furniture's stops short of the wall, so their boxes from depth points rarely overlap in plan
 STACK_PAD_M = 0.30
+# a thing hung on a wall (a painting, a wall TV, a mirror) has a box this thin in plan, or thinner
+HUNG_THIN_M = 0.2
+# m: how far short of the wall a piece of furniture's memory box may stop and still stand under a
+# thing hung on that wall: built from the depth points of its front and top, the box of a bed,
+# dresser or chair pushed against the wall rarely reaches the wall behind it
+HUNG_REACH_M = 0.8
 ROOM_DECAY_M = 2.5  # m: a room cue's weight falls by e over this planar distance
 ROOM_REACH_M = 6.0  # m: cues farther than this say nothing of an object's room
 # below this posterior the room is unknown (chosen on ProcTHOR train textnav, seeds 0 and 1)
@@ -111,6 +117,26 @@ def _plan_overlap(a: BoxLike, b: BoxLike, pad: float = 0.05) -> bool:
     return bool(a0[0] <= b1[0] + pad and b0[0] <= a1[0] + pad and a0[1] <= b1[1] + pad and b0[1] <= a1[1] + pad)
 
 
+def hung_over(top: BoxLike, low: BoxLike) -> bool:
+    """Whether ``top``, a thing hung on a wall (its footprint at most ``HUNG_THIN_M`` thick along
+    x or y), hangs over ``low``: their footprints overlap along the wall (within the boxes'
+    noise) and ``low``'s box stops at most ``HUNG_REACH_M`` short of it across the wall. The
+    ground truth's "under" wants the footprints to overlap; a memory box of furniture against
+    the wall stops short of it."""
+    t0, t1 = np.asarray(top.box_min, float), np.asarray(top.box_max, float)
+    l0, l1 = np.asarray(low.box_min, float), np.asarray(low.box_max, float)
+    ext = t1[:2] - t0[:2]
+    for k in (0, 1):  # k: the axis across the wall
+        j = 1 - k
+        if ext[k] > HUNG_THIN_M or ext[k] > ext[j]:
+            continue
+        along = t0[j] <= l1[j] + BOX_NOISE_M and l0[j] <= t1[j] + BOX_NOISE_M
+        across = max(l0[k] - t1[k], t0[k] - l1[k], 0.0)
+        if along and across <= HUNG_REACH_M:
+            return True
+    return False
+
+
 def _centre_in_plan(a: BoxLike, b: BoxLike, pad: float = 0.10) -> bool:
     return centre_in_footprint(a.box_min, a.box_max, b.box_min, b.box_max, pad)
 
@@ -143,7 +169,7 @@ def relation_grade(relation: str, a: BoxLike, b: BoxLike) -> str:
         top, low = (b, a) if rel != "above" else (a, b)
         if float(top.box_min[2]) < float(low.box_max[2]) - ON_GAP_M:
             return "fails"
-        if _plan_overlap(a, b, BOX_NOISE_M):
+        if _plan_overlap(a, b, BOX_NOISE_M) or hung_over(top, low):
             return "holds"
         return "marginal" if _plan_overlap(a, b, STACK_PAD_M) else "fails"
     if rel == "in":

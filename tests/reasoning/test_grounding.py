@@ -78,15 +78,15 @@ def test_a_relation_held_only_within_the_box_noise_is_marginal():
     assert relation_grade("next to", a, node(3, "floor_lamp", (1.5, 0), (0.3, 0.3))) == "marginal"  # 1.05 m
     assert relation_grade("next to", a, node(4, "floor_lamp", (1.65, 0), (0.3, 0.3))) == "fails"  # 1.2 m
     assert relation_grade("near", a, node(5, "floor_lamp", (2.5, 0), (0.3, 0.3))) == "marginal"  # 2.05 m
-    # stacked: a painting over a chair whose box stops 0.05 m short of it holds; 0.25 m short,
-    # only within the pad a bed's box that stops short of its wall needs
-    painting = node(6, "painting", (0, 0.6), (0.8, 0.04), (1.2, 1.8))
-    near_chair = node(7, "chair", (0, 0.33), (0.5, 0.4), (0.0, 0.9))  # 0.05 m short
-    far_chair = node(8, "chair", (0, 0.13), (0.5, 0.4), (0.0, 0.9))  # 0.25 m short
-    assert relation_grade("under", near_chair, painting) == "holds"
-    assert relation_grade("below", far_chair, painting) == "marginal"
-    assert relation_grade("above", painting, far_chair) == "marginal"
-    assert relation_grade("under", node(9, "chair", (0, -0.3), (0.5, 0.4)), painting) == "fails"
+    # stacked: a lamp on a shelf over a chair whose box stops 0.05 m short of it holds; 0.25 m
+    # short, only within the stacking pad (a thing hung on a wall is more lenient: next test but one)
+    lamp = node(6, "desk_lamp", (0, 0.6), (0.3, 0.3), (1.2, 1.6))
+    near_chair = node(7, "chair", (0, 0.2), (0.5, 0.4), (0.0, 0.9))  # 0.05 m short
+    far_chair = node(8, "chair", (0, 0.0), (0.5, 0.4), (0.0, 0.9))  # 0.25 m short
+    assert relation_grade("under", near_chair, lamp) == "holds"
+    assert relation_grade("below", far_chair, lamp) == "marginal"
+    assert relation_grade("above", lamp, far_chair) == "marginal"
+    assert relation_grade("under", node(9, "chair", (0, -0.3), (0.5, 0.4)), lamp) == "fails"
 
 
 def test_on_a_support_whose_box_stops_short_in_plan_is_marginal():
@@ -139,6 +139,23 @@ def test_a_painting_on_the_wall_above_a_bed_against_it_is_above_the_bed():
     assert relation_holds("under", bed, painting) and relation_holds("above", painting, bed)
     across_the_room = node(3, "painting", (1.0, 3.0), (0.8, 0.04), (1.2, 1.8))
     assert not relation_holds("under", bed, across_the_room)
+
+
+def test_furniture_whose_box_stops_short_of_the_wall_still_stands_under_what_hangs_there():
+    """A chair or dresser against a wall is mapped from its front and top: its box may stop well
+    short of the wall. Under a thing hung on that wall (a thin box) it still stands, as long as
+    they overlap along the wall; not when it stands beside it along the wall, farther out than
+    furniture reaches, or when the upper thing is no wall-hung one."""
+    painting = node(1, "painting", (1.0, 3.02), (0.8, 0.04), (1.2, 1.8))  # on the wall y = 3.04
+    chair = node(2, "chair", (1.2, 2.0), (0.5, 0.5), (0.0, 0.9))  # box stops 0.75 m short of it
+    assert relation_grade("under", chair, painting) == "holds"
+    assert relation_grade("above", painting, chair) == "holds"
+    beside = node(3, "chair", (2.2, 2.6), (0.5, 0.5), (0.0, 0.9))  # along the wall, past its end
+    assert relation_grade("under", beside, painting) == "fails"
+    out_in_the_room = node(4, "chair", (1.0, 1.4), (0.5, 0.5), (0.0, 0.9))  # 1.35 m out
+    assert relation_grade("under", out_in_the_room, painting) == "fails"
+    vase = node(5, "vase", (1.0, 3.02), (0.2, 0.2), (1.0, 1.3))  # not thin: no allowance
+    assert relation_grade("under", node(6, "table", (1.0, 2.2), (0.6, 0.6), (0.0, 0.9)), vase) == "fails"
 
 
 def test_room_words_map_to_the_four_room_types():
