@@ -23,6 +23,8 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from hiconav.reasoning.grounding import ground, infer_rooms, target_relations
+from hiconav.reasoning.room_prior import load as load_room_prior
+from hiconav.reasoning.room_prior import log_ratios
 
 from hiconav.reasoning import replies
 from hiconav.reasoning.config import ReasoningConfig
@@ -214,6 +216,11 @@ class OfflineVerifier:
                  similarity: Callable[[str, str], float] | None = None) -> None:
         self.config = config or ReasoningConfig()
         self.similarity = similarity
+        path = self.config.offline.room_prior
+        try:
+            self._room_cues = log_ratios(load_room_prior(path)) if path else None
+        except (OSError, ValueError) as exc:
+            raise ValueError(f"reasoning.offline.room_prior: {exc}") from None
 
     def cancel(self) -> None:  # same interface as VLMVerifier; nothing in flight
         return None
@@ -264,7 +271,7 @@ class OfflineVerifier:
         # would otherwise confirm the wrong instance beside it
         support = [o for o in objects + context if self._weak(o) is None] if described else []
         # and so must the objects that tell a room (a false "bed" makes a bedroom)
-        rooms = infer_rooms(support, ignore=task.targets) if described else None
+        rooms = infer_rooms(support, ignore=task.targets, cues=self._room_cues) if described else None
         groundings: dict[int, Any] = {}
         for obj in subgraph.objects:
             score, target = self._match(obj.label, task.targets)

@@ -87,3 +87,25 @@ def test_the_command_learns_from_a_houses_file_anywhere_and_round_trips(tmp_path
     for cat, counts in prior.counts.items():
         for room, n in counts.items():
             assert n <= shipped.counts[cat].get(room, 0), (cat, room)
+
+
+def test_a_users_own_prior_file_anywhere_decides_the_rooms_and_a_bad_one_names_the_setting(tmp_path):
+    from hiconav.reasoning.config import ReasoningConfig
+    from hiconav.reasoning.verifier import OfflineVerifier
+
+    from .test_grounding import TASK, _living_room_scene, graph
+
+    scene = graph(_living_room_scene())  # armchair #1 by a floor lamp, a sofa in view
+    shipped = OfflineVerifier(ReasoningConfig()).verify(scene, TASK)
+    assert shipped.found and shipped.hypothesis.object_id == 1
+    # houses of the user's own where sofas stand in bedrooms
+    path = tmp_path / "elsewhere" / "my_prior.json"
+    path.parent.mkdir()
+    room_prior.save(RoomPrior({"sofa": {"bedroom": 50}, "bed": {"living_room": 50},
+                               "fridge": {"kitchen": 50}, "toilet": {"bathroom": 50}}, "mine"), path)
+    config = ReasoningConfig.model_validate({"offline": {"room_prior": str(path)}})
+    mine = OfflineVerifier(config).verify(scene, TASK)
+    assert not mine.found and mine.verdicts[1] == "fails"
+    missing = ReasoningConfig.model_validate({"offline": {"room_prior": str(tmp_path / "nope.json")}})
+    with pytest.raises(ValueError, match=r"reasoning\.offline\.room_prior: .*nope\.json"):
+        OfflineVerifier(missing)
