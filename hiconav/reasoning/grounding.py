@@ -24,7 +24,7 @@ Verdicts are "holds", "marginal" (every relation holds, some only within the mem
 noise margin: ``relation_grade``), "fails" or "unknown" (the related object is not in the
 subgraph, or no room can be inferred), so a described instance is confirmed only when every
 relation holds; a marginal one is offered after a wait (``unresolved.due_marginal``). Pure
-functions; no I/O, no clocks.
+functions; no clocks, and no I/O but the first read of the shipped room prior (package data).
 """
 
 from __future__ import annotations
