@@ -31,6 +31,7 @@ SUBCOMMANDS: list[tuple[str, str, str]] = [
     ("sim", "hiconav.sim.cli", "sim"),
     ("vehicle", "hiconav.drivers.cli", "vehicle"),
     ("parse", "hiconav.reasoning.cli", "parse"),
+    ("room-prior", "hiconav.reasoning.cli", "room_prior"),
     ("eval", "hiconav.eval.cli", "eval"),
     ("episodes", "hiconav.sim.episodes_cli", "episodes"),
     ("tree", "hiconav.trees.cli", "tree"),

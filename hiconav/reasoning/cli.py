@@ -68,3 +68,25 @@ def _load_config():
     except (ImportError, AttributeError):
         pass
     return ReasoningConfig()
+
+
+def room_prior(
+    houses: str = typer.Option(..., "--houses", help="A ProcTHOR houses file (.jsonl or .jsonl.gz), anywhere on "
+                               "disk: training houses only, never those you report on."),
+    out: str = typer.Option(None, "--out", help="Where to write the counts (default: the shipped "
+                            "hiconav/reasoning/room_prior.json)."),
+) -> None:
+    """Count object categories per room type in houses: the room prior the offline reasoner infers
+    rooms from (``reasoning.offline.room_prior`` points it at a file of your own)."""
+    from pathlib import Path
+
+    from hiconav.reasoning import room_prior as rp
+
+    target = out or str(rp.DEFAULT_FILE)
+    prior = rp.learn(rp.houses_of(houses), source=Path(houses).name)
+    if not prior.counts:
+        raise typer.BadParameter(f"{houses}: no object stands in a bedroom, bathroom, kitchen or living room",
+                                 param_hint="--houses")
+    rp.save(prior, target)
+    n = sum(sum(c.values()) for c in prior.counts.values())
+    typer.echo(json.dumps({"houses": houses, "categories": len(prior.counts), "objects": n, "out": target}))

@@ -72,7 +72,7 @@ class OfflineVerifierConfig(BaseModel):
     confident_observations: int = Field(10, ge=0)
     min_similarity: float = Field(0.85, ge=0, le=1)  # label-target similarity when not equal
     # the counts of categories per room type the rooms are inferred from (a file written by
-    # ``python -m hiconav.reasoning.room_prior --houses FILE``); None: the shipped counts, from
+    # ``hiconav room-prior --houses FILE``); None: the shipped counts, from
     # the ProcTHOR train houses
     room_prior: str | None = None
 

@@ -18,14 +18,13 @@ give no cue.
 
 The counts ship as ``room_prior.json`` beside this module, written by
 
-    python -m hiconav.reasoning.room_prior --houses ../shared/data/procthor/train.jsonl.gz
+    hiconav room-prior --houses ../shared/data/procthor/train.jsonl.gz
 
-Pure apart from ``load`` / ``save`` and the command line.
+Pure apart from ``load`` / ``save`` and ``houses_of``.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 from collections import Counter
@@ -144,20 +143,7 @@ def default_log_ratios() -> dict[str, dict[str, float]]:
     return log_ratios(load(DEFAULT_FILE))
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m hiconav.reasoning.room_prior",
-                                 description="Count object categories per room type in training houses.")
-    ap.add_argument("--houses", required=True, help="a ProcTHOR houses file (.jsonl or .jsonl.gz): training houses only")
-    ap.add_argument("--out", default=str(DEFAULT_FILE), help="where to write the counts (default: the shipped file)")
-    args = ap.parse_args(argv)
-    prior = learn(_houses(args.houses), source=Path(args.houses).name)
-    save(prior, args.out)
-    n = sum(sum(c.values()) for c in prior.counts.values())
-    print(json.dumps({"houses": args.houses, "categories": len(prior.counts), "objects": n, "out": args.out}))
-    return 0
-
-
-def _houses(path: str) -> Iterable[Any]:
+def houses_of(path: str) -> Iterable[Any]:
     """Every house of a ProcTHOR houses file, loaded one by one (``FILE#N``), uncached."""
     from hiconav.sim import load_house
     from hiconav.sim.procthor import split_lines
@@ -165,7 +151,3 @@ def _houses(path: str) -> Iterable[Any]:
     resolved = str(Path(path).expanduser().resolve())
     for i in range(len(split_lines(resolved))):
         yield load_house(f"{resolved}#{i}", cache=False)
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

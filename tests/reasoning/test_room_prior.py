@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from hiconav.cli import main as cli_main
 from hiconav.reasoning import room_prior
 from hiconav.reasoning.grounding import infer_rooms
 from hiconav.reasoning.room_prior import RoomPrior, from_json, load, log_ratios
@@ -76,7 +77,7 @@ def test_the_command_learns_from_a_houses_file_anywhere_and_round_trips(tmp_path
     with gzip.open(houses, "wt", encoding="utf-8") as fh:
         fh.writelines(lines)
     out = tmp_path / "prior.json"
-    assert room_prior.main(["--houses", str(houses), "--out", str(out)]) == 0
+    assert cli_main(["room-prior", "--houses", str(houses), "--out", str(out)]) == 0
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     prior = load(out)
     assert prior.source == "two.jsonl.gz" and summary["categories"] == len(prior.counts) > 0
@@ -109,3 +110,13 @@ def test_a_users_own_prior_file_anywhere_decides_the_rooms_and_a_bad_one_names_t
     missing = ReasoningConfig.model_validate({"offline": {"room_prior": str(tmp_path / "nope.json")}})
     with pytest.raises(ValueError, match=r"reasoning\.offline\.room_prior: .*nope\.json"):
         OfflineVerifier(missing)
+
+
+def test_the_command_names_a_houses_file_it_cannot_read(tmp_path, capsys):
+    assert cli_main(["room-prior", "--houses", str(tmp_path / "nope.jsonl.gz"), "--out", str(tmp_path / "p.json")]) == 2
+    assert "nope.jsonl.gz" in capsys.readouterr().err
+    bad = tmp_path / "bad.jsonl"
+    bad.write_text('{"rooms": [\n')
+    assert cli_main(["room-prior", "--houses", str(bad), "--out", str(tmp_path / "p.json")]) == 2
+    assert "bad.jsonl:1" in capsys.readouterr().err
+    assert not (tmp_path / "p.json").exists()  # nothing half-written
