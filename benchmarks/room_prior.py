@@ -25,8 +25,8 @@ import argparse
 import json
 import sys
 from collections import Counter, defaultdict
-from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -37,22 +37,13 @@ SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "procthor" / 
 THRESHOLDS = (0.5, 0.6, 0.7, 0.8, 0.9)
 
 
-@dataclass(frozen=True)
-class Node:
-    id: int
-    label: str
-    box_min: np.ndarray
-    box_max: np.ndarray
-    anchor_ids: tuple[int, ...]
-
-
-def house_nodes(house) -> tuple[list[Node], dict[int, str]]:
+def house_nodes(house) -> tuple[list[SimpleNamespace], dict[int, str]]:
     """Nodes of a house's objects in the four room types (the room's index as their common
     anchor: one room, one view) and each node's true room."""
     from hiconav.sim.task_episodes import GroundTruth
 
     gt = GroundTruth(house)
-    nodes: list[Node] = []
+    nodes: list[SimpleNamespace] = []  # what infer_rooms reads of a memory node
     truth: dict[int, str] = {}
     for k, obj in enumerate(house.objects):
         room = ROOM_TYPES.get(str(gt.room_of(k)))
@@ -62,7 +53,8 @@ def house_nodes(house) -> tuple[list[Node], dict[int, str]]:
         c, s = np.asarray(obj.center, float), np.asarray(obj.size, float)
         cy, sy = abs(np.cos(obj.yaw)), abs(np.sin(obj.yaw))
         half = np.array([(s[0] * cy + s[1] * sy) / 2, (s[0] * sy + s[1] * cy) / 2, s[2] / 2])
-        nodes.append(Node(k, str(obj.category), c - half, c + half, (int(idx),)))
+        nodes.append(SimpleNamespace(id=k, label=str(obj.category), box_min=c - half, box_max=c + half,
+                                     anchor_ids=(int(idx),)))
         truth[k] = room
     return nodes, truth
 
@@ -85,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         for i in range(n_houses):
             nodes, truth = house_nodes(load_house(f"{path}#{i}", cache=False))
-            by_label: dict[str, list[Node]] = defaultdict(list)
+            by_label: dict[str, list[SimpleNamespace]] = defaultdict(list)
             for n in nodes:
                 by_label[n.label].append(n)
             for label, group in by_label.items():
