@@ -73,20 +73,17 @@ def main(argv: list[str] | None = None) -> int:
     n_houses = len(split_lines(path)) if args.limit is None else min(args.limit, len(split_lines(path)))
     rows: list[tuple[str, str | None, float]] = []  # (true room, argmax room, its posterior)
     shipped = grounding.ROOM_MIN_POSTERIOR
-    grounding.ROOM_MIN_POSTERIOR = 0.0  # the argmax room and its posterior; thresholds below
-    try:
-        for i in range(n_houses):
-            nodes, truth = house_nodes(load_house(f"{path}#{i}", cache=False))
-            by_label: dict[str, list[SimpleNamespace]] = defaultdict(list)
-            for n in nodes:
-                by_label[n.label].append(n)
-            for label, group in by_label.items():
-                rooms = grounding.infer_rooms(nodes, ignore=(label,), cues=cues)
-                for n in group:
-                    room, p = rooms[n.id]
-                    rows.append((truth[n.id], room, p if room is not None else 0.0))
-    finally:
-        grounding.ROOM_MIN_POSTERIOR = shipped
+    for i in range(n_houses):
+        nodes, truth = house_nodes(load_house(f"{path}#{i}", cache=False))
+        by_label: dict[str, list[SimpleNamespace]] = defaultdict(list)
+        for n in nodes:
+            by_label[n.label].append(n)
+        for label, group in by_label.items():
+            # every argmax room with its posterior; the thresholds are applied below
+            rooms = grounding.infer_rooms(nodes, ignore=(label,), cues=cues, min_posterior=0.0)
+            for n in group:
+                room, p = rooms[n.id]
+                rows.append((truth[n.id], room, p if room is not None else 0.0))
 
     def figures(t: float, subset=None) -> dict:
         rs = [r for r in rows if subset is None or r[0] == subset]

@@ -186,14 +186,16 @@ def relation_grade(relation: str, a: BoxLike, b: BoxLike) -> str:
 
 # ---------------------------------------------------------------------------------------- rooms
 def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = (),
-                cues: Mapping[str, Mapping[str, float]] | None = None) -> dict[int, tuple[str | None, float]]:
+                cues: Mapping[str, Mapping[str, float]] | None = None,
+                min_posterior: float = ROOM_MIN_POSTERIOR) -> dict[int, tuple[str | None, float]]:
     """Object id -> (inferred room type or None, its posterior) for every object.
 
     A naive-Bayes posterior over ``ROOMS`` from a uniform prior: every object co-visible with it
     (a common anchor) within ``ROOM_REACH_M``, and itself, adds its category's log-likelihood
     ratios (``cues``; default: learnt from the ProcTHOR training houses, ``room_prior``) weighted
     by exp(-gap / ROOM_DECAY_M). The most probable room is inferred when its posterior reaches
-    ``ROOM_MIN_POSTERIOR``, else None; None with 0.0 when no object with a cue was seen with it.
+    ``min_posterior`` (default ``ROOM_MIN_POSTERIOR``), else None; None with 0.0 when no object
+    with a cue was seen with it.
     Objects whose label is in ``ignore`` give no cue: for "the tv in the bedroom" the tvs are
     what the description tells apart, so a tv's own lean to the living room must not decide
     which room it is in."""
@@ -202,14 +204,13 @@ def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = (),
     # co-visibility: a common anchor, pruned ones included where the node keeps them (observed_by)
     anchors = {o.id: set(getattr(o, "observed_by", ()) or getattr(o, "anchor_ids", ()) or ()) for o in objects}
     skip = {label_key(str(t)) for t in ignore}
+    # the objects that give a cue, with their ratios per room (looked up once, not per pair)
+    cue_objects = [(other, [float(ratios.get(room, 0.0)) for room in ROOMS]) for other in objects
+                   if (key := label_key(str(other.label))) not in skip and (ratios := table.get(key))]
     for o in objects:
         logit = dict.fromkeys(ROOMS, 0.0)
         seen = False
-        for other in objects:
-            key = label_key(str(other.label))
-            ratios = table.get(key)
-            if not ratios or key in skip:
-                continue
+        for other, ratios in cue_objects:
             if other.id != o.id and not (anchors[o.id] & anchors[other.id]):
                 continue
             gap = 0.0 if other.id == o.id else planar_gap(o, other)
@@ -217,8 +218,8 @@ def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = (),
                 continue
             w = math.exp(-gap / ROOM_DECAY_M)
             seen = True
-            for room in ROOMS:
-                logit[room] += w * float(ratios.get(room, 0.0))
+            for room, r in zip(ROOMS, ratios):
+                logit[room] += w * r
         if not seen:
             out[o.id] = (None, 0.0)
             continue
@@ -226,7 +227,7 @@ def infer_rooms(objects: Sequence[BoxLike], ignore: Iterable[str] = (),
         z = sum(math.exp(v - top) for v in logit.values())
         room, v = max(logit.items(), key=lambda kv: (kv[1], kv[0]))
         p = math.exp(v - top) / z
-        out[o.id] = (room if p >= ROOM_MIN_POSTERIOR else None, p)
+        out[o.id] = (room if p >= min_posterior else None, p)
     return out
 
 
