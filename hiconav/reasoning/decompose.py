@@ -319,6 +319,10 @@ FILLERS = frozenset([
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must",
 ])
+# words that open an object relative clause ("the dresser that the tv is on") and determiners
+# that open its subject when no such word does ("the table the laptop is on")
+RELATIVE_MARKERS = frozenset(["that", "which", "whom"])
+CLAUSE_DETERMINERS = frozenset(["the", "a", "an", "my", "your", "our", "their", "his", "her", "some"])
 PRONOUNS = frozenset([
     "it", "its", "it's", "itself", "they", "them", "this", "that", "which", "one", "ones",
 ])
@@ -442,6 +446,7 @@ class OfflineParser:
             words = self._strip_imperatives(words)
             if not words:
                 continue
+            words = self._unstrand(words)
             segments = self._segments(words)
             head_words, rest = segments[0][1], segments[1:]
             if refers_to_target:
@@ -596,6 +601,38 @@ class OfflineParser:
                 words = words[1:]
                 changed = True
         return words
+
+    def _unstrand(self, words: list[str]) -> list[str]:
+        """An object relative clause ends on its preposition: "the dresser (that) the tv is on",
+        "the bed the painting hangs above". The object named first is the one sought, and the
+        clause says what stands on, under, by ... it; rewritten as "the dresser with the tv on
+        it", which the segments read the same way (``with``, then the pronoun for the sought
+        object). Unchanged when the words do not end on a relation phrase, when what precedes
+        it does not split into two noun phrases (a clause marker or a second determiner between
+        them), or when the first phrase holds a relation of its own."""
+        for phrase in _RELATION_KEYS:
+            rel = phrase.split()
+            n = len(rel)
+            if len(words) > n and words[-n:] == rel and not self._relation_is_part_of_name(words, len(words) - n, n):
+                break
+        else:
+            return words
+        body = list(words[:-n])
+        while body and body[-1] in FILLERS and body[-1] not in RELATIVE_MARKERS:
+            body.pop()  # "is", "sits", "hangs": the clause's verb
+        marker = next((i for i in range(len(body) - 1, 0, -1) if body[i] in RELATIVE_MARKERS), None)
+        if marker is not None:
+            first, second = body[:marker], body[marker + 1:]
+        else:
+            cut = next((i for i in range(1, len(body)) if body[i] in CLAUSE_DETERMINERS), None)
+            if cut is None:
+                return words
+            first, second = body[:cut], body[cut:]
+        if len(self._segments(first)) != 1 or len(self._segments(second)) != 1:
+            return words  # a relation inside either phrase: not this construction
+        if not self._noun_phrases(first) or not self._noun_phrases([w for w in second if w not in PRONOUNS]):
+            return words
+        return first + ["with"] + second + rel + ["it"]
 
     def _refers_to_target(self, words: list[str], targets: list[NounPhrase]) -> bool:
         if words and words[0] in ("it", "it's", "its", "this", "which"):

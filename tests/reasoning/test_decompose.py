@@ -168,6 +168,31 @@ def test_leading_phrases_of_people_asking_to_go_somewhere_are_not_objects(parser
     assert task.attributes.get("garbage_can", ()) == ()
 
 
+@pytest.mark.parametrize("text,target,relation", [
+    ("the dresser that the tv is on", "dresser", ("tv", "on", "dresser")),
+    ("take me to the table the laptop is on", "dining_table", ("laptop", "on", "dining_table")),
+    ("find the bed the painting hangs above", "bed", ("painting", "above", "bed")),
+    ("go to the counter which the coffee machine sits on", "counter_top", ("coffee_machine", "on", "counter_top")),
+    ("find the tv that the sofa is facing", "tv", ("sofa", "facing", "tv")),
+])
+def test_a_clause_ending_on_its_preposition_describes_the_object_named_first(parser, text, target,
+                                                                              relation) -> None:
+    # "the dresser that the tv is on": the dresser is sought, and the tv stands on it
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert relation in task.relations
+
+
+@pytest.mark.parametrize("text,relations", [
+    ("the dresser that is next to the bed", (("dresser", "next to", "bed"),)),
+    ("go to the chair next to", ()),  # a relation with nothing after it says nothing
+])
+def test_ordinary_clauses_and_a_dangling_relation_are_read_as_before(parser, text, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (relations[0][0] if relations else "chair",)
+    assert task.relations == relations
+
+
 def test_synonyms_follow_the_active_vocabulary() -> None:
     p = OfflineParser(("refrigerator", "couch", "potted_plant", "television"), no_similarity)
     assert p.parse("find the fridge").targets == ("refrigerator",)
