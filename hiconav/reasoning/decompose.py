@@ -24,7 +24,7 @@ from __future__ import annotations
 import logging
 import re
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from hiconav.errors import HiconavError
 from hiconav.reasoning.config import ReasoningConfig
@@ -170,6 +170,13 @@ ROOMS: dict[str, str] = {
     "study": "office", "laundry room": "laundry_room", "laundry": "laundry_room",
     "garage": "garage", "nursery": "bedroom", "guest room": "bedroom", "master bedroom": "bedroom",
 }
+
+_ROOM_PATTERN = "|".join(re.escape(r) for r in sorted(ROOMS, key=len, reverse=True))
+# words that may stand before a room's name without naming an object: "the second bathroom",
+# "the main bedroom", "the upstairs bathroom" (the room is still a room of that type)
+ROOM_QUALIFIERS = frozenset(["first", "second", "third", "fourth", "other", "main", "spare", "upstairs",
+                             "downstairs", "front", "back", "kids", "kid's", "children's", "small", "smaller",
+                             "big", "bigger", "large", "larger", "little", "en", "suite", "ensuite"])
 
 # Co-occurrence priors (common sense of household layouts): label -> related objects, most
 # telling first. Entries not in the active vocabulary are dropped.
@@ -533,6 +540,7 @@ class OfflineParser:
         for p in related:
             if p.in_room and (p.label, "in", p.in_room) not in relations:
                 relations.append((p.label, "in", p.in_room))
+        relations = self._lamp_on_furniture(targets, relations, attributes)
         target_labels = list(dict.fromkeys(p.label for p in targets))
         for room in dict.fromkeys(rooms):
             rel = (target_labels[0], "in", room)
@@ -575,6 +583,11 @@ class OfflineParser:
     def _sentences(text: str) -> list[str]:
         text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
         text = re.sub(r"[\"“”()\[\]{}:]", " ", text)
+        # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
+        # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
+        text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
+        # "the bedroom's tv": a room named in the possessive is the room word
+        text = re.sub(rf"\b({_ROOM_PATTERN})'s\b", r"\1", text)
         parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:find|look|go|search|locate|navigate|take|walk|head)\b)"
                          r"|\s+and\s+(?=(?:find|look for|search for|locate)\b)", text)
         out = []
@@ -601,6 +614,23 @@ class OfflineParser:
                 words = words[1:]
                 changed = True
         return words
+
+    def _lamp_on_furniture(self, targets: list[NounPhrase], relations: list[tuple[str, str, str]],
+                           attributes: dict[str, list[str]]) -> list[tuple[str, str, str]]:
+        """"The lamp on the nightstand": a plain "lamp" reads as a floor lamp, but one that stands
+        on something is a desk (table) lamp. The target becomes the desk lamp, in its relations
+        and attributes too, when the vocabulary has both and the words named no kind of lamp."""
+        floor, desk = self.lexicon.lookup("floor lamp"), self.lexicon.lookup("desk lamp")
+        if not targets or floor is None or desk is None or floor == desk or targets[0].label != floor:
+            return relations
+        if set(targets[0].text.split()) - ATTRIBUTE_WORDS - {"lamp", "lamps", "light", "lights"}:
+            return relations  # "the floor lamp", "the standing lamp": said so
+        if not any(s == floor and r == "on" for s, r, _ in relations):
+            return relations
+        targets[0] = replace(targets[0], label=desk)
+        if floor in attributes:
+            attributes[desk] = attributes.pop(floor)
+        return [(desk if s == floor else s, r, desk if o == floor else o) for s, r, o in relations]
 
     def _unstrand(self, words: list[str]) -> list[str]:
         """An object relative clause ends on its preposition: "the dresser (that) the tv is on",
@@ -721,8 +751,9 @@ class OfflineParser:
         # Rooms ("the kitchen", "the master bedroom").
         for n in range(min(3, len(words)), 0, -1):
             tail = " ".join(words[-n:])
-            if tail in ROOMS and not any(w not in ATTRIBUTE_WORDS for w in words[:-n]):
-                return NounPhrase(ROOMS[tail], tuple(words[:-n]), text, False, room=ROOMS[tail])
+            if tail in ROOMS and not any(w not in ATTRIBUTE_WORDS and w not in ROOM_QUALIFIERS for w in words[:-n]):
+                return NounPhrase(ROOMS[tail], tuple(w for w in words[:-n] if w in ATTRIBUTE_WORDS), text, False,
+                                  room=ROOMS[tail])
         attrs = [w for w in words if w in ATTRIBUTE_WORDS]
         rest = [w for w in words if w not in ATTRIBUTE_WORDS]
         if not rest:  # "the white one", or a noun that is also an attribute word ("light")

@@ -193,6 +193,40 @@ def test_ordinary_clauses_and_a_dangling_relation_are_read_as_before(parser, tex
     assert task.relations == relations
 
 
+@pytest.mark.parametrize("text,target,relation", [
+    ("the plant in the kitchen - go there", "plant", ("plant", "in", "kitchen")),  # a dash parts clauses
+    ("the plant in the kitchen \u2014 go there", "plant", ("plant", "in", "kitchen")),
+    ("the bedroom's tv", "tv", ("tv", "in", "bedroom")),  # a room in the possessive
+    ("go to the living room's sofa", "sofa", ("sofa", "in", "living_room")),
+    ("find the toilet in the second bathroom", "toilet", ("toilet", "in", "bathroom")),  # a qualified room
+    ("the tv in the main bedroom", "tv", ("tv", "in", "bedroom")),
+    ("the chair in the upstairs bathroom", "chair", ("chair", "in", "bathroom")),
+])
+def test_rooms_as_people_write_them(parser, text, target, relation) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == (relation,)
+    assert task.attributes == {}
+
+
+def test_a_hyphen_inside_a_word_stays_one_word(parser) -> None:
+    assert parser.parse("find the t-shirt").targets == parser.parse("find the t shirt").targets
+
+
+@pytest.mark.parametrize("text,target", [
+    ("I need the lamp on the nightstand", "desk_lamp"),  # a lamp standing on furniture
+    ("the small lamp on the desk", "desk_lamp"),
+    ("the floor lamp on the rug", "floor_lamp"),  # said so
+    ("the lamp next to the bed", "floor_lamp"),
+    ("find the lamp", "floor_lamp"),
+])
+def test_a_lamp_on_something_is_a_desk_lamp(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert all(s == target for s, _, _ in task.relations)
+    assert set(task.attributes) <= {target}
+
+
 def test_synonyms_follow_the_active_vocabulary() -> None:
     p = OfflineParser(("refrigerator", "couch", "potted_plant", "television"), no_similarity)
     assert p.parse("find the fridge").targets == ("refrigerator",)
