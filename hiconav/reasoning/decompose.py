@@ -95,7 +95,8 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("cell phone", "cellphone", "phone", "mobile phone", "smartphone", "mobile", "smart phone"):
         ("cell_phone",),
     ("remote control", "remote", "tv remote", "clicker"): ("remote_control",),
-    ("painting", "picture", "artwork", "poster", "framed picture", "portrait", "canvas"): ("painting",),
+    ("painting", "picture", "artwork", "poster", "framed picture", "portrait", "canvas", "photo", "photograph",
+     "framed photo", "picture frame", "photo frame", "wall art", "print"): ("painting",),
     ("counter top", "countertop", "counter", "kitchen counter", "worktop", "kitchen island",
      "island"): ("counter_top", "counter"),
     ("floor lamp", "standing lamp", "lamp", "light"): ("floor_lamp", "lamp"),
@@ -754,6 +755,16 @@ class OfflineParser:
             if tail in ROOMS and not any(w not in ATTRIBUTE_WORDS and w not in ROOM_QUALIFIERS for w in words[:-n]):
                 return NounPhrase(ROOMS[tail], tuple(w for w in words[:-n] if w in ATTRIBUTE_WORDS), text, False,
                                   room=ROOMS[tail])
+        # a name whose last word is also an attribute word ("toilet paper"): the name, not a
+        # paper toilet (names that start with one, "wooden chair", keep it as an attribute)
+        for n in range(min(self.lexicon.max_words, len(words)), 1, -1):
+            tail = words[-n:]
+            hit = self.lexicon.lookup(" ".join(tail)) if tail[-1] in ATTRIBUTE_WORDS else None
+            if hit is not None:
+                head = words[:-n]
+                modifiers, in_room = _room_modifier([w for w in head if w not in ATTRIBUTE_WORDS])
+                return NounPhrase(hit, tuple([w for w in head if w in ATTRIBUTE_WORDS] + modifiers), text, True,
+                                  in_room=in_room)
         attrs = [w for w in words if w in ATTRIBUTE_WORDS]
         rest = [w for w in words if w not in ATTRIBUTE_WORDS]
         if not rest:  # "the white one", or a noun that is also an attribute word ("light")

@@ -227,6 +227,22 @@ def test_a_lamp_on_something_is_a_desk_lamp(parser, text, target) -> None:
     assert set(task.attributes) <= {target}
 
 
+@pytest.mark.parametrize("text,target,attributes", [
+    ("find the toilet paper", "toilet_paper", {}),  # "paper" is a material word, and the name's head
+    ("the white toilet paper", "toilet_paper", {"toilet_paper": ("white",)}),
+    ("the wooden chair", "chair", {"chair": ("wooden",)}),  # a name that starts with one keeps it
+])
+def test_a_name_ending_in_an_attribute_word_is_the_name(parser, text, target, attributes) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.attributes == attributes
+
+
+@pytest.mark.parametrize("name", ["photo", "photograph", "picture frame", "framed photo", "wall art"])
+def test_pictures_people_name_otherwise_are_paintings(parser, name) -> None:
+    assert parser.parse(f"the bed below the {name}").relations == (("bed", "below", "painting"),)
+
+
 def test_synonyms_follow_the_active_vocabulary() -> None:
     p = OfflineParser(("refrigerator", "couch", "potted_plant", "television"), no_similarity)
     assert p.parse("find the fridge").targets == ("refrigerator",)
