@@ -170,6 +170,9 @@ ROOMS: dict[str, str] = {
     "hallway": "hallway", "hall": "hallway", "corridor": "hallway", "office": "office",
     "study": "office", "laundry room": "laundry_room", "laundry": "laundry_room",
     "garage": "garage", "nursery": "bedroom", "guest room": "bedroom", "master bedroom": "bedroom",
+    # "the fridge in the kitchen area": an area named after a room is that room
+    "kitchen area": "kitchen", "living area": "living_room", "sitting area": "living_room",
+    "lounge area": "living_room", "dining area": "dining_room", "sleeping area": "bedroom",
 }
 
 _ROOM_PATTERN = "|".join(re.escape(r) for r in sorted(ROOMS, key=len, reverse=True))
@@ -304,7 +307,11 @@ RELATIONS: dict[str, str] = {
     "around": "near", "from": "near",
     # superlatives ("the chair closest to the fridge") read as near: which of several is the
     # closest needs every one of them seen, near is what a single view can check
-    "closest to": "near", "nearest to": "near", "nearest the": "near",
+    "closest to": "near", "nearest to": "near", "nearest the": "near", "closer to": "near", "nearer to": "near",
+    "nearer the": "near",
+    # "the painting on the left side of the bed": a side named as a place is the side of
+    "on the left side of": "left of", "to the left side of": "left of", "left side of": "left of",
+    "on the right side of": "right of", "to the right side of": "right of", "right side of": "right of",
     # "the desk that has a lamp on it": what it carries is near it (its own relation, "on it",
     # follows and is parsed on the carried object)
     "has": "with", "have": "with", "having": "with", "holding": "with", "holds": "with",
@@ -542,6 +549,9 @@ class OfflineParser:
             if p.in_room and (p.label, "in", p.in_room) not in relations:
                 relations.append((p.label, "in", p.in_room))
         relations = self._lamp_on_furniture(targets, relations, attributes)
+        # an object related to itself ("the table in the dining area" read as a table in a
+        # table) says nothing to check, and would hold the search for ever
+        relations = [(a, r, b) for a, r, b in relations if a != b]
         target_labels = list(dict.fromkeys(p.label for p in targets))
         for room in dict.fromkeys(rooms):
             rel = (target_labels[0], "in", room)

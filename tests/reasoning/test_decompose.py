@@ -243,6 +243,18 @@ def test_pictures_people_name_otherwise_are_paintings(parser, name) -> None:
     assert parser.parse(f"the bed below the {name}").relations == (("bed", "below", "painting"),)
 
 
+@pytest.mark.parametrize("text,relations", [
+    ("go to the painting on the left side of the bed", (("painting", "left of", "bed"),)),
+    ("the chair to the right side of the sofa", (("chair", "right of", "sofa"),)),
+    ("the bed that is closer to the window", (("bed", "near", "window"),)),
+    ("the bed nearer the door", (("bed", "near", "door"),)),
+    ("the fridge in the kitchen area", (("fridge", "in", "kitchen"),)),
+    ("take me to the table in the dining area", (("dining_table", "in", "dining_room"),)),
+])
+def test_sides_comparatives_and_areas_as_people_say_them(parser, text, relations) -> None:
+    assert parser.parse(text).relations == relations
+
+
 def test_synonyms_follow_the_active_vocabulary() -> None:
     p = OfflineParser(("refrigerator", "couch", "potted_plant", "television"), no_similarity)
     assert p.parse("find the fridge").targets == ("refrigerator",)
