@@ -332,8 +332,13 @@ FILLERS = frozenset([
     "standing", "stands", "lying", "lies", "positioned", "found", "kept", "hung", "hanging", "set",
     "resting", "rests", "there", "it's", "its", "just", "right", "directly", "somewhere", "usually",
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
-    "displayed", "installed", "be", "should", "must",
+    "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
 ])
+# what introduces the object after a relation said first ("in the bedroom there is a TV")
+EXISTENTIALS: tuple[str, ...] = tuple(sorted((
+    "there is", "there's", "there are", "there sits", "there stands", "there hangs", "you will find",
+    "you'll find", "you can find", "you will see", "you'll see", "you can see", "you should see",
+    "i left", "stands", "sits", "hangs", "lies", "is"), key=lambda p: -len(p.split())))
 # words that open an object relative clause ("the dresser that the tv is on") and determiners
 # that open its subject when no such word does ("the table the laptop is on")
 RELATIVE_MARKERS = frozenset(["that", "which", "whom"])
@@ -454,6 +459,7 @@ class OfflineParser:
         relations: list[tuple[str, str, str]] = []
         rooms: list[str] = []
         attributes: dict[str, list[str]] = {}
+        ahead: list[tuple[str, NounPhrase]] = []  # relations said before their object was named
 
         for si, sentence in enumerate(sentences):
             words = sentence.split()
@@ -461,7 +467,7 @@ class OfflineParser:
             words = self._strip_imperatives(words)
             if not words:
                 continue
-            words = self._unstrand(words)
+            words = self._unstrand(self._front(words))
             segments = self._segments(words)
             head_words, rest = segments[0][1], segments[1:]
             if refers_to_target:
@@ -478,10 +484,13 @@ class OfflineParser:
             else:
                 subjects = self._noun_phrases(head_words)
                 if not subjects:
-                    # "In the kitchen, find the chair ...": a room ahead of the object it holds
+                    # "In the kitchen, find the chair ...": a room ahead of the object it holds;
+                    # "Beside the bed, find the dresser": an object ahead of it, said of the target
                     for relation, np_words in rest:
+                        phrases = self._noun_phrases(np_words)
                         if relation in CONTAINMENT:
-                            rooms += [p.room for p in self._noun_phrases(np_words) if p.room]
+                            rooms += [p.room for p in phrases if p.room]
+                        ahead += [(relation, p) for p in phrases if not p.room and p.label not in PLACE_NOUNS]
                     continue
                 room_only = [p for p in subjects if p.room]
                 objs = [p for p in subjects if p.room is None]
@@ -540,6 +549,11 @@ class OfflineParser:
                     attributes.setdefault(p.label, [])
                     attributes[p.label] += [a for a in p.attributes if a not in attributes[p.label]]
 
+        if targets:
+            for relation, p in ahead:
+                if p.label != targets[0].label and (targets[0].label, relation, p.label) not in relations:
+                    relations.append((targets[0].label, relation, p.label))
+                    related.append(p)
         if not targets:
             raise InstructionError(f"no object found in the instruction {instruction!r}",
                                    field="instruction")
@@ -599,7 +613,8 @@ class OfflineParser:
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
         # "the bedroom's tv": a room named in the possessive is the room word
         text = re.sub(rf"\b({_ROOM_PATTERN})'s\b", r"\1", text)
-        parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:find|look|go|search|locate|navigate|take|walk|head)\b)"
+        parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"
+                         r"(?:find|look|go|search|locate|navigate|take|walk|head|bring|show|get)\b)"
                          r"|\s+and\s+(?=(?:find|look for|search for|locate)\b)", text)
         out = []
         for part in parts:
@@ -642,6 +657,31 @@ class OfflineParser:
         if floor in attributes:
             attributes[desk] = attributes.pop(floor)
         return [(desk if s == floor else s, r, desk if o == floor else o) for s, r, o in relations]
+
+    def _front(self, words: list[str]) -> list[str]:
+        """A relation said first: "next to the floor lamp, there's an armchair", "in the bedroom
+        there is a TV", "under the painting you will find a chair". Rewritten with the object
+        first ("an armchair next to the floor lamp"), as the segments read it; unchanged unless
+        the words open with a relation phrase and hold one of ``EXISTENTIALS`` after it, or a
+        comma and a noun phrase ("near the window, the armchair")."""
+        first = next((p for p in _RELATION_KEYS if words[:len(p.split())] == p.split()), None)
+        if first is None:
+            return words
+        n = len(first.split())
+        for i in range(n + 1, len(words)):
+            for marker in EXISTENTIALS:
+                m = marker.split()
+                if words[i:i + len(m)] == m and len(words) > i + len(m):
+                    landmark = [w for w in words[n:i] if w != ","]
+                    thing = [w for w in words[i + len(m):] if w != ","]
+                    if landmark and self._noun_phrases(thing):
+                        return thing + words[:n] + landmark
+        if "," in words[n + 1:]:  # "in the bathroom, the toilet under the painting"
+            i = words.index(",", n + 1)
+            landmark, thing = words[n:i], [w for w in words[i + 1:] if w != ","]
+            if landmark and thing and self._noun_phrases(thing) and self._noun_phrases(self._segments(thing)[0][1]):
+                return thing + words[:n] + landmark
+        return words
 
     def _unstrand(self, words: list[str]) -> list[str]:
         """An object relative clause ends on its preposition: "the dresser (that) the tv is on",

@@ -255,6 +255,31 @@ def test_sides_comparatives_and_areas_as_people_say_them(parser, text, relations
     assert parser.parse(text).relations == relations
 
 
+@pytest.mark.parametrize("text,target,relations", [
+    ("Next to the floor lamp in the living room, there's an armchair. Go to it.", "armchair",
+     (("armchair", "next to", "floor_lamp"), ("armchair", "in", "living_room"))),
+    ("In the bedroom there is a TV. Find it.", "tv", (("tv", "in", "bedroom"),)),
+    ("On the dining table there is a laptop; take me to it.", "laptop", (("laptop", "on", "dining_table"),)),
+    ("Under the painting you will find a chair", "chair", (("chair", "under", "painting"),)),
+    ("On top of the dresser sits a plant", "plant", (("plant", "on", "dresser"),)),
+    ("Beside the bed, find the dresser", "dresser", (("dresser", "next to", "bed"),)),
+    ("In the kitchen next to the fridge, find the chair", "chair",
+     (("chair", "next to", "fridge"), ("chair", "in", "kitchen"))),
+    ("near the window, the armchair", "armchair", (("armchair", "near", "window"),)),
+    ("in the bathroom, the toilet under the painting", "toilet",
+     (("toilet", "under", "painting"), ("toilet", "in", "bathroom"))),
+    ("I left my laptop on the bed, can you go there?", "laptop", (("laptop", "on", "bed"),)),
+    ("The TV that's in the bedroom, please go there", "tv", (("tv", "in", "bedroom"),)),
+])
+def test_a_relation_said_before_its_object(parser, text, target, relations) -> None:
+    # these failed outright ("no object found") or read the wrong target before
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert set(relations) <= set(task.relations)
+    assert all(r[0] != r[2] for r in task.relations)
+    assert not any(o.endswith("_go") or o in ("go", "can_you_go") for _, _, o in task.relations)
+
+
 def test_synonyms_follow_the_active_vocabulary() -> None:
     p = OfflineParser(("refrigerator", "couch", "potted_plant", "television"), no_similarity)
     assert p.parse("find the fridge").targets == ("refrigerator",)
