@@ -5,8 +5,10 @@ templates ("take me to the chair next to the fridge"). People say the same thing
 a room word before the noun ("the kitchen table"), the room first ("In the kitchen, find the
 chair ..."), a follow-up sentence ("Find the chair. The one
 next to the fridge."), a relative clause ("the chair that is next to the fridge"), a polite
-lead ("I'd like to go to ..."). A parser that reads only the templates loses the description and
-stops at the first instance of the category it sees.
+lead ("I'd like to go to ..."), the relation first ("Next to the fridge, there's a chair. Take me
+to it."), a room in the possessive ("the kitchen's chair"), a dashed afterthought ("the chair
+next to the fridge - go there"). A parser that reads only the templates loses the description
+and stops at the first instance of the category it sees.
 
 For each textnav instruction the script writes every form below that applies, decomposes the
 template and each form offline (``decompose_instruction``, MiniLM similarity) and counts a form as
@@ -44,6 +46,13 @@ from hiconav.sim.task_episodes import TEXTNAV_PHRASINGS, spoken
 LEAD = re.compile("^(?:" + "|".join(re.escape(p.split("{np}")[0]) for p in TEXTNAV_PHRASINGS) + ")",
                   re.IGNORECASE)
 ROOM = re.compile(r"in the (kitchen|living room|bedroom|bathroom)")
+# descriptions that may be said relation first ("Next to the fridge, there's a chair."): one
+# relation phrase, then its object
+FRONTABLE = re.compile(r"(?:in|on|on top of|next to|beside|by|near|under|below|beneath|above|close to) the [a-z ]+")
+
+
+def _article(name: str) -> str:
+    return "an" if name[:1] in "aeiou" else "a"
 
 
 def forms(instruction: str, target: str) -> dict[str, str]:
@@ -62,9 +71,14 @@ def forms(instruction: str, target: str) -> dict[str, str]:
         "question": f"Could you head over to the {name} {rest}?",
         "bare": f"the {name} {rest}, please",
     }
+    out["dash"] = f"the {name} {rest} - go there"
+    if FRONTABLE.match(rest):
+        first = rest[0].upper() + rest[1:]
+        out["relation first"] = f"{first}, there's {_article(name)} {name}. Take me to it."
     room = ROOM.fullmatch(rest)
     if room:
         out["room word"] = f"take me to the {room.group(1)} {name}"
+        out["room possessive"] = f"can you find the {room.group(1)}'s {name}?"
     tail = re.search(r"\s*\b" + ROOM.pattern + "$", rest)
     if tail:
         before = rest[:tail.start()].strip()

@@ -175,7 +175,6 @@ ROOMS: dict[str, str] = {
     "lounge area": "living_room", "dining area": "dining_room", "sleeping area": "bedroom",
 }
 
-_ROOM_PATTERN = "|".join(re.escape(r) for r in sorted(ROOMS, key=len, reverse=True))
 # words that may stand before a room's name without naming an object: "the second bathroom",
 # "the main bedroom", "the upstairs bathroom" (the room is still a room of that type)
 ROOM_QUALIFIERS = frozenset(["first", "second", "third", "fourth", "other", "main", "spare", "upstairs",
@@ -611,8 +610,6 @@ class OfflineParser:
         # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
-        # "the bedroom's tv": a room named in the possessive is the room word
-        text = re.sub(rf"\b({_ROOM_PATTERN})'s\b", r"\1", text)
         parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"
                          r"(?:find|look|go|search|locate|navigate|take|walk|head|bring|show|get)\b)"
                          r"|\s+and\s+(?=(?:find|look for|search for|locate)\b)", text)
@@ -672,7 +669,9 @@ class OfflineParser:
             for marker in EXISTENTIALS:
                 m = marker.split()
                 if words[i:i + len(m)] == m and len(words) > i + len(m):
-                    landmark = [w for w in words[n:i] if w != ","]
+                    landmark = words[n:i]
+                    while landmark and landmark[-1] == ",":
+                        landmark = landmark[:-1]  # a comma inside keeps a second relation on the object
                     thing = [w for w in words[i + len(m):] if w != ","]
                     if landmark and self._noun_phrases(thing):
                         return thing + words[:n] + landmark
@@ -798,6 +797,13 @@ class OfflineParser:
                 words = words[:k]
         if not words:
             return None
+        # "the bedroom's tv", "the kitchen's chair": a room in the possessive places the object
+        # in it, even where room and noun also make a name ("kitchen chair")
+        for n in (3, 2, 1):
+            head = " ".join(words[:n])
+            if len(words) > n and head.endswith("'s") and head[:-2] in ROOMS:
+                np_ = self._noun_phrase(words[n:])
+                return None if np_ is None else replace(np_, in_room=np_.in_room or ROOMS[head[:-2]])
         text = " ".join(words)
         # Rooms ("the kitchen", "the master bedroom").
         for n in range(min(3, len(words)), 0, -1):
