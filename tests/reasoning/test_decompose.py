@@ -281,6 +281,18 @@ def test_a_relation_said_before_its_object(parser, text, target, relations) -> N
     assert not any(o.endswith("_go") or o in ("go", "can_you_go") for _, _, o in task.relations)
 
 
+@pytest.mark.parametrize("name,label", [
+    ("divan", "sofa"), ("chesterfield", "sofa"), ("fern", "plant"), ("cactus", "plant"), ("palm tree", "plant"),
+    ("wingback chair", "armchair"), ("club chair", "armchair"), ("desk light", "desk_lamp"),
+    ("study lamp", "desk_lamp"), ("floor light", "floor_lamp"), ("dressing table", "dresser"),
+    ("plushie", "teddy_bear"), ("laptop pc", "laptop"), ("bust", "statue"), ("statuette", "statue"),
+    ("flatscreen", "tv"),
+])
+def test_more_names_people_give_the_target_categories(parser, name, label) -> None:
+    # names that neither the synonym table nor the embedder's threshold mapped before
+    assert parser.parse(f"find the {name}").targets == (label,)
+
+
 def test_synonyms_follow_the_active_vocabulary() -> None:
     p = OfflineParser(("refrigerator", "couch", "potted_plant", "television"), no_similarity)
     assert p.parse("find the fridge").targets == ("refrigerator",)
