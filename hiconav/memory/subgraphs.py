@@ -50,8 +50,9 @@ class Subgraph:
     priority: float
     signature: tuple
     focus_object_id: int | None = None
-    # memory objects near the focus object that its anchors do not show (a described instance:
-    # "the laptop near the tv stand" holds on the map even when no one image holds both)
+    # memory objects near the instances of the target it shows that its anchors do not show (a
+    # described instance: "the laptop near the tv stand" holds on the map even when no one image
+    # holds both)
     context: tuple[ObjectView, ...] = ()
 
     @property
@@ -100,6 +101,21 @@ def _context(snapshot: MemorySnapshot, focus: ObjectView, shown: tuple[ObjectVie
     return tuple(o for o in snapshot.objects if o.id not in have and footprint_gap(focus.box_min, focus.box_max, o.box_min, o.box_max) <= radius)
 
 
+def _around_targets(snapshot: MemorySnapshot, shown: tuple[ObjectView, ...], targets: tuple[str, ...],
+                    matches: Callable[[str, tuple[str, ...]], bool], radius: float,
+                    first: ObjectView | None = None) -> tuple[ObjectView, ...]:
+    """``_context`` of each object of ``shown`` that ``matches`` a target word (``first``, the
+    focus, before the others), each node once, in that order."""
+    out: list[ObjectView] = []
+    have = {o.id for o in shown}
+    for t in ([first] if first is not None else []) + [o for o in shown if o is not first and matches(o.label, targets)]:
+        for o in _context(snapshot, t, shown, radius):
+            if o.id not in have:
+                have.add(o.id)
+                out.append(o)
+    return tuple(out)
+
+
 def _described(task: TaskSpec) -> bool:
     """The task singles out one instance by relations whose subject is one of its targets."""
     targets = {label_key(t) for t in task.targets}
@@ -116,10 +132,13 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
               far_evidence_weight: float = 0.5, context_m: float = 2.5) -> list[Subgraph]:
     """Subgraphs of ``snapshot`` for ``task``, in the order the reasoner should query them.
 
-    For a described instance (relations on the target), each target subgraph also carries the
-    memory objects within ``context_m`` of its focus object's box that its anchors do not show
-    (``Subgraph.context``, part of its signature: a related object mapped from elsewhere makes
-    the subgraph due again). 0: none.
+    For a described instance (relations on the target), each subgraph also carries the memory
+    objects within ``context_m`` of the box of each instance of the target it shows (a target
+    subgraph's focus first) that its anchors do not show (``Subgraph.context``, part of its
+    signature: a related object mapped from elsewhere makes the subgraph due again). Every
+    instance a subgraph shows is judged on it, and one seen at the edge of a related or remaining
+    subgraph (a painting in the view that centres the bed) was judged on what those images hold
+    alone: its room read from the bed next door, not the sink beside it. 0: none.
 
     similarity(a, b) -> float in [-1, 1] (e.g. ``Embedder.similarity``). An object matches a
     target/related word when the normalised labels are equal or their similarity is at least
@@ -148,6 +167,11 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
     out: list[Subgraph] = []
     used: set[int] = set()
     described = context_m > 0 and _described(task)
+    targets = tuple(task.targets)
+
+    def is_target(label: str, words: tuple[str, ...]) -> bool:
+        return _matches(label, words, similarity, label_match_threshold)
+
     for kind, words in (("target", tuple(task.targets)), ("related", tuple(task.related))):
         if not words:
             continue
@@ -165,7 +189,8 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
                 continue  # the VLM would see exactly the same images again
             used.update(a.id for a in chosen)
             objs = _objects_of(snapshot, chosen)
-            near = _context(snapshot, o, objs, context_m) if kind == "target" and described else ()
+            near = (_around_targets(snapshot, objs, targets, is_target, context_m, o if kind == "target" else None)
+                    if described else ())
             sig = _signature(kind, chosen, objs) + ((tuple((c.id, c.label) for c in near),) if near else ())
             built.append(Subgraph(kind, chosen, objs, score(chosen, objs), sig, o.id, near))
         if kind == "related":
@@ -179,8 +204,9 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
     for i in range(0, len(ranked), k):
         chunk = tuple(sorted(ranked[i:i + k], key=lambda a: a.id))
         objs = _objects_of(snapshot, chunk)
-        groups.append(Subgraph("remaining", chunk, objs, score(chunk, objs),
-                               _signature("remaining", chunk, objs)))
+        near = _around_targets(snapshot, objs, targets, is_target, context_m) if described else ()
+        sig = _signature("remaining", chunk, objs) + ((tuple((c.id, c.label) for c in near),) if near else ())
+        groups.append(Subgraph("remaining", chunk, objs, score(chunk, objs), sig, None, near))
     groups.sort(key=lambda g: (-g.priority, g.anchors[0].id))
     out.extend(groups)
     return out

@@ -148,3 +148,27 @@ def test_a_described_target_subgraph_carries_the_nodes_mapped_near_it():
     plain = decompose(snap, TASK, similarity, k=5)[0]
     assert plain.context == () and plain.signature == target.signature[:-1]
     assert decompose(snap, described, similarity, k=5, context_m=0.0)[0].context == ()
+
+
+def test_every_instance_a_subgraph_shows_carries_the_nodes_mapped_near_it():
+    """ "the bed near the lamp", a second bed (node 8, at x = 8 m) also seen at the edge of the
+    view that centres the fridge (node 7): it is judged on that subgraph too, so the sink beside it (node
+    9, 1.6 m off, in no anchor of that subgraph) comes with it."""
+    labels = {**LABELS, 8: "bed", 9: "sink"}
+    edges = {k: dict(v) for k, v in EDGES.items()}
+    edges[7] = {7: BIG, 8: BOX}  # the fridge's view shows the second bed at its edge
+    edges[8] = {9: BOX}  # the sink, from elsewhere
+    edges[11] = {8: BIG}  # the second bed's own best view, its target subgraph (k = 1)
+    described = TaskSpec("the bed near the lamp", ("bed",), ("fridge",), relations=(("bed", "near", "lamp"),))
+    subgraphs = decompose(snapshot_from(edges, labels), described, similarity, k=1)
+    shown = {g.focus_object_id: g for g in subgraphs if g.kind == "related"}
+    fridge = shown[7]
+    assert 8 in fridge.object_ids and 9 not in fridge.object_ids
+    assert 9 in [o.id for o in fridge.context]  # mapped 1.6 m from the bed it shows
+    assert fridge.signature[-1] == tuple((o.id, o.label) for o in fridge.context)
+    # the focus's neighbours come first in a target subgraph
+    first = next(g for g in subgraphs if g.kind == "target" and g.focus_object_id == 0)
+    assert [o.id for o in first.context][:2] == [1, 2]  # the nightstand and lamp beside bed 0
+    # without a description no subgraph carries anything
+    plain = decompose(snapshot_from(edges, labels), TaskSpec("find the bed", ("bed",), ("fridge",)), similarity, k=1)
+    assert all(g.context == () for g in plain)
