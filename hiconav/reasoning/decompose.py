@@ -295,6 +295,8 @@ reach|visit|show me|where is|where's|where are|i'm looking for|i am looking for|
 i want to find|i need to find|i need|i want|i lost|we need|
 stop at|stop by|stop near|go stand by|stand next to|stand by|end up at|come to|
 the target is|target|your goal is|the goal is|goal|object|it is|it's|there is|there's|
+take me over to|bring me over to|come over to|look around for|search around for|have a look for|
+go look for|go and look for|hey robot|hi robot|hello robot|ok robot|okay robot|hey|hi|hello|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # Relation phrases -> canonical relation (longest match first).
@@ -340,6 +342,9 @@ FILLERS = frozenset([
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
 ])
+# a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
+VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
+                       "thanks", "thank", "you", "so", "um", "uh", "well"])
 # what introduces the object after a relation said first ("in the bedroom there is a TV")
 EXISTENTIALS: tuple[str, ...] = tuple(sorted((
     "there is", "there's", "there are", "there sits", "there stands", "there hangs", "you will find",
@@ -471,8 +476,8 @@ class OfflineParser:
             words = sentence.split()
             refers_to_target = bool(targets) and self._refers_to_target(words, targets)
             words = self._strip_imperatives(words)
-            if not words:
-                continue
+            if not words or all(w in VOCATIVES for w in words):
+                continue  # "Hey robot, go to ...": the robot addressed, no object named
             words = self._unstrand(self._front(words))
             segments = self._segments(words)
             head_words, rest = segments[0][1], segments[1:]
@@ -802,8 +807,8 @@ class OfflineParser:
                 return NounPhrase(ROOMS[after], (), " ".join(words), False, room=ROOMS[after])
             if " ".join(words) not in self.lexicon.phrases and k > 0:
                 words = words[:k]
-        if not words:
-            return None
+        if not words or all(w in VOCATIVES for w in words):
+            return None  # "Okay, so, the chair ...": words to the robot, no object
         # "the bedroom's tv", "the kitchen's chair": a room in the possessive places the object
         # in it, even where room and noun also make a name ("kitchen chair")
         for n in (3, 2, 1):

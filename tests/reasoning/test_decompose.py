@@ -293,6 +293,20 @@ def test_more_names_people_give_the_target_categories(parser, name, label) -> No
     assert parser.parse(f"find the {name}").targets == (label,)
 
 
+@pytest.mark.parametrize("text,target,relations", [
+    ("take me over to the fridge please", "fridge", ()),  # "over" was read as "above"
+    ("hey robot, go to the kitchen sink", "sink", ()),  # the robot addressed was the target
+    ("robot, find the laptop", "laptop", ()),
+    ("look around for the statue", "statue", ()),  # a target "look"
+    ("Okay, so, the chair next to the desk", "chair", (("chair", "next to", "desk"),)),
+    ("hello robot go to the sofa", "sofa", ()),
+])
+def test_words_to_the_robot_name_no_object(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+
+
 def test_synonyms_follow_the_active_vocabulary() -> None:
     p = OfflineParser(("refrigerator", "couch", "potted_plant", "television"), no_similarity)
     assert p.parse("find the fridge").targets == ("refrigerator",)
