@@ -297,6 +297,7 @@ stop at|stop by|stop near|go stand by|stand next to|stand by|end up at|come to|
 the target is|target|your goal is|the goal is|goal|object|it is|it's|there is|there's|
 take me over to|bring me over to|come over to|look around for|search around for|have a look for|
 go look for|go and look for|hey robot|hi robot|hello robot|ok robot|okay robot|hey|hi|hello|
+by the way|anyway|btw|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # Relation phrases -> canonical relation (longest match first).
@@ -501,7 +502,9 @@ class OfflineParser:
                         phrases = self._noun_phrases(np_words)
                         if relation in CONTAINMENT:
                             rooms += [p.room for p in phrases if p.room]
-                        ahead += [(relation, p) for p in phrases if not p.room and p.label not in PLACE_NOUNS]
+                        # only objects the vocabulary knows: "by the way, find the bed" names none
+                        ahead += [(relation, p) for p in phrases
+                                  if not p.room and p.label not in PLACE_NOUNS and p.in_vocabulary]
                     continue
                 room_only = [p for p in subjects if p.room]
                 objs = [p for p in subjects if p.room is None]

@@ -300,6 +300,7 @@ def test_more_names_people_give_the_target_categories(parser, name, label) -> No
     ("look around for the statue", "statue", ()),  # a target "look"
     ("Okay, so, the chair next to the desk", "chair", (("chair", "next to", "desk"),)),
     ("hello robot go to the sofa", "sofa", ()),
+    ("by the way, find the bed", "bed", ()),  # no object "way" beside the bed
 ])
 def test_words_to_the_robot_name_no_object(parser, text, target, relations) -> None:
     task = parser.parse(text)
