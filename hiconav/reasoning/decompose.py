@@ -326,6 +326,11 @@ RELATIONS: dict[str, str] = {
     "has": "with", "have": "with", "having": "with", "holding": "with", "holds": "with",
 }
 _RELATION_KEYS = sorted(RELATIONS, key=lambda p: -len(p.split()))
+
+
+def _relation_at(words: Sequence[str], i: int) -> str | None:
+    """The longest relation phrase (a ``RELATIONS`` key) that starts at ``words[i]``, or None."""
+    return next((p for p in _RELATION_KEYS if list(words[i:i + len(p.split())]) == p.split()), None)
 # words after which a noun phrase names what is excluded ("in the kitchen, not the bathroom")
 NEGATIONS = ("not", "instead", "except")  # "rather" is also an intensifier ("the rather large chair")
 # nouns for a part of a room or of a house, never an object: "in the corner", "at the far end"
@@ -676,7 +681,7 @@ class OfflineParser:
         first ("an armchair next to the floor lamp"), as the segments read it; unchanged unless
         the words open with a relation phrase and hold one of ``EXISTENTIALS`` after it, or a
         comma and a noun phrase ("near the window, the armchair")."""
-        first = next((p for p in _RELATION_KEYS if words[:len(p.split())] == p.split()), None)
+        first = _relation_at(words, 0)
         if first is None:
             return words
         n = len(first.split())
@@ -747,14 +752,9 @@ class OfflineParser:
         segments: list[tuple[str, list[str]]] = [("", [])]
         i = 0
         while i < len(words):
-            matched = None
-            for phrase in _RELATION_KEYS:
-                n = len(phrase.split())
-                if words[i:i + n] == phrase.split():
-                    matched = (phrase, n)
-                    break
-            if matched and not self._relation_is_part_of_name(words, i, matched[1]):
-                phrase, n = matched
+            phrase = _relation_at(words, i)
+            n = len(phrase.split()) if phrase else 0
+            if phrase and not self._relation_is_part_of_name(words, i, n):
                 segments.append((RELATIONS[phrase], []))
                 i += n
                 continue
