@@ -101,14 +101,14 @@ def _context(snapshot: MemorySnapshot, focus: ObjectView, shown: tuple[ObjectVie
     return tuple(o for o in snapshot.objects if o.id not in have and footprint_gap(focus.box_min, focus.box_max, o.box_min, o.box_max) <= radius)
 
 
-def _around_targets(snapshot: MemorySnapshot, shown: tuple[ObjectView, ...], targets: tuple[str, ...],
-                    matches: Callable[[str, tuple[str, ...]], bool], radius: float,
-                    first: ObjectView | None = None) -> tuple[ObjectView, ...]:
-    """``_context`` of each object of ``shown`` that ``matches`` a target word (``first``, the
-    focus, before the others), each node once, in that order."""
+def _around_targets(snapshot: MemorySnapshot, shown: tuple[ObjectView, ...], is_target: Callable[[str], bool],
+                    radius: float, first: ObjectView | None = None) -> tuple[ObjectView, ...]:
+    """``_context`` of each object of ``shown`` whose label ``is_target`` (``first``, the focus,
+    before the others), each node once, in that order."""
     out: list[ObjectView] = []
     have = {o.id for o in shown}
-    for t in ([first] if first is not None else []) + [o for o in shown if o is not first and matches(o.label, targets)]:
+    rest = [o for o in shown if (first is None or o.id != first.id) and is_target(o.label)]
+    for t in ([first] if first is not None else []) + rest:
         for o in _context(snapshot, t, shown, radius):
             if o.id not in have:
                 have.add(o.id)
@@ -169,10 +169,10 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
     described = context_m > 0 and _described(task)
     targets = tuple(task.targets)
 
-    def is_target(label: str, words: tuple[str, ...]) -> bool:
-        return _matches(label, words, similarity, label_match_threshold)
+    def is_target(label: str) -> bool:
+        return _matches(label, targets, similarity, label_match_threshold)
 
-    for kind, words in (("target", tuple(task.targets)), ("related", tuple(task.related))):
+    for kind, words in (("target", targets), ("related", tuple(task.related))):
         if not words:
             continue
         focus = [o for o in snapshot.objects if _matches(o.label, words, similarity, label_match_threshold)]
@@ -189,7 +189,7 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
                 continue  # the VLM would see exactly the same images again
             used.update(a.id for a in chosen)
             objs = _objects_of(snapshot, chosen)
-            near = (_around_targets(snapshot, objs, targets, is_target, context_m, o if kind == "target" else None)
+            near = (_around_targets(snapshot, objs, is_target, context_m, o if kind == "target" else None)
                     if described else ())
             sig = _signature(kind, chosen, objs) + ((tuple((c.id, c.label) for c in near),) if near else ())
             built.append(Subgraph(kind, chosen, objs, score(chosen, objs), sig, o.id, near))
@@ -204,7 +204,7 @@ def decompose(snapshot: MemorySnapshot, task: TaskSpec, similarity: Callable[[st
     for i in range(0, len(ranked), k):
         chunk = tuple(sorted(ranked[i:i + k], key=lambda a: a.id))
         objs = _objects_of(snapshot, chunk)
-        near = _around_targets(snapshot, objs, targets, is_target, context_m) if described else ()
+        near = _around_targets(snapshot, objs, is_target, context_m) if described else ()
         sig = _signature("remaining", chunk, objs) + ((tuple((c.id, c.label) for c in near),) if near else ())
         groups.append(Subgraph("remaining", chunk, objs, score(chunk, objs), sig, None, near))
     groups.sort(key=lambda g: (-g.priority, g.anchors[0].id))
