@@ -40,7 +40,7 @@ from pathlib import Path
 from hiconav.reasoning.config import ReasoningConfig
 from hiconav.reasoning.decompose import decompose_instruction
 from hiconav.reasoning.grounding import target_relations
-from hiconav.sim.task_episodes import TEXTNAV_PHRASINGS, spoken
+from hiconav.sim.task_episodes import TEXTNAV_PHRASINGS, _article, spoken
 
 # the generator's leading words ("take me to the "), read off its templates
 LEAD = re.compile("^(?:" + "|".join(re.escape(p.split("{np}")[0]) for p in TEXTNAV_PHRASINGS) + ")",
@@ -49,10 +49,6 @@ ROOM = re.compile(r"in the (kitchen|living room|bedroom|bathroom)")
 # descriptions that may be said relation first ("Next to the fridge, there's a chair."): one
 # relation phrase, then its object
 FRONTABLE = re.compile(r"(?:in|on|on top of|next to|beside|by|near|under|below|beneath|above|close to) the [a-z ]+")
-
-
-def _article(name: str) -> str:
-    return "an" if name[:1] in "aeiou" else "a"
 
 
 def forms(instruction: str, target: str) -> dict[str, str]:
