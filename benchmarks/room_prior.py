@@ -70,7 +70,8 @@ def main(argv: list[str] | None = None) -> int:
 
     path = str(Path(args.houses).expanduser().resolve())
     cues = log_ratios(load(args.prior)) if args.prior else default_log_ratios()
-    n_houses = len(split_lines(path)) if args.limit is None else min(args.limit, len(split_lines(path)))
+    n_lines = len(split_lines(path))  # reads (and decompresses) the whole file: once
+    n_houses = n_lines if args.limit is None else min(args.limit, n_lines)
     rows: list[tuple[str, str | None, float]] = []  # (true room, argmax room, its posterior)
     shipped = grounding.ROOM_MIN_POSTERIOR
     for i in range(n_houses):
