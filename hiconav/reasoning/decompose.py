@@ -67,35 +67,35 @@ DEFAULT_VOCABULARY: tuple[str, ...] = (
 # active vocabulary wins (so "fridge" resolves to "refrigerator" in a vocabulary that uses that).
 _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("sofa", "couch", "settee", "loveseat", "love seat", "sectional", "sofa bed", "divan", "futon",
-     "chesterfield"): ("sofa", "couch"),
+     "chesterfield", "two seater", "three seater", "seater"): ("sofa", "couch"),
     ("tv", "television", "tv set", "television set", "telly", "flat screen", "flatscreen tv",
-     "flat screen tv", "tv screen", "television screen", "smart tv", "flatscreen", "flat-screen tv"): ("tv", "television"),
+     "flat screen tv", "tv screen", "television screen", "smart tv", "flatscreen", "flat-screen tv", "plasma screen", "plasma tv", "lcd tv"): ("tv", "television"),
     ("plant", "potted plant", "house plant", "houseplant", "pot plant", "indoor plant",
      "flower pot", "flowerpot", "plant pot", "planter", "flowers", "flower", "fern", "succulent", "cactus",
-     "ficus", "palm", "palm tree", "monstera", "bonsai", "orchid", "indoor tree", "potted tree"):
+     "ficus", "palm", "palm tree", "monstera", "bonsai", "orchid", "indoor tree", "potted tree", "greenery"):
         ("plant", "potted_plant", "house_plant"),
     ("fridge", "refrigerator", "freezer", "icebox"): ("fridge", "refrigerator"),
     ("dining table", "dinner table", "kitchen table", "dining-table", "table", "eating table"):
         ("table", "dining_table"),
     ("side table", "nightstand", "night stand", "bedside table", "night table", "end table",
-     "bedside cabinet"): ("side_table", "nightstand"),
+     "bedside cabinet", "occasional table", "accent table", "lamp table", "bedside stand"): ("side_table", "nightstand"),
     ("coffee table", "cocktail table", "tea table", "low table"): ("coffee_table",),
-    ("desk", "writing desk", "office desk", "computer desk", "work desk"): ("desk",),
+    ("desk", "writing desk", "office desk", "computer desk", "work desk", "workstation", "writing table", "study table", "computer table", "work table", "worktable", "secretary desk"): ("desk",),
     ("chair", "dining chair", "kitchen chair", "office chair", "desk chair", "wooden chair",
      "seat"): ("chair",),
     ("armchair", "arm chair", "recliner", "easy chair", "lounge chair", "accent chair", "wingback",
      "wingback chair", "wing chair", "club chair", "reading chair"):
         ("armchair", "arm_chair", "chair"),
-    ("bed", "double bed", "single bed", "king bed", "queen bed", "bunk bed"): ("bed",),
+    ("bed", "double bed", "single bed", "king bed", "queen bed", "bunk bed", "daybed", "day bed", "twin bed", "guest bed"): ("bed",),
     ("toilet", "wc", "commode", "loo", "water closet", "toilet bowl", "lavatory"): ("toilet",),
     ("sink", "washbasin", "wash basin", "basin", "kitchen sink", "bathroom sink", "handbasin"):
         ("sink",),
     ("bathtub", "bath tub", "tub", "bath", "jacuzzi", "hot tub"): ("bathtub",),
     ("shower", "shower stall", "shower cabin"): ("shower",),
     ("garbage can", "trash can", "trashcan", "bin", "trash bin", "garbage bin", "wastebasket",
-     "waste basket", "dustbin", "rubbish bin", "waste bin"): ("garbage_can",),
+     "waste basket", "dustbin", "rubbish bin", "waste bin", "wastepaper basket", "waste paper basket", "wastepaper bin", "litter bin", "pedal bin", "kitchen bin", "garbage", "trash", "rubbish"): ("garbage_can",),
     ("shelving unit", "shelf", "shelves", "bookshelf", "bookcase", "book shelf", "shelving",
-     "rack"): ("shelving_unit", "shelf"),
+     "rack", "book case", "etagere", "shelf unit"): ("shelving_unit", "shelf"),
     ("cell phone", "cellphone", "phone", "mobile phone", "smartphone", "mobile", "smart phone"):
         ("cell_phone",),
     ("remote control", "remote", "tv remote", "clicker"): ("remote_control",),
@@ -103,26 +103,26 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
      "framed photo", "picture frame", "photo frame", "wall art", "print"): ("painting",),
     ("counter top", "countertop", "counter", "kitchen counter", "worktop", "kitchen island",
      "island"): ("counter_top", "counter"),
-    ("floor lamp", "standing lamp", "lamp", "light", "floor light", "standard lamp"): ("floor_lamp", "lamp"),
+    ("floor lamp", "standing lamp", "lamp", "light", "floor light", "standard lamp", "torchiere", "uplighter", "uplight", "arc lamp"): ("floor_lamp", "lamp"),
     ("desk lamp", "table lamp", "reading lamp", "bedside lamp", "desk light", "study lamp", "bedside light",
-     "table light"): ("desk_lamp", "lamp"),
-    ("coffee machine", "coffee maker", "espresso machine", "coffeemaker"): ("coffee_machine",),
-    ("washing machine", "washer", "laundry machine"): ("washing_machine",),
-    ("clothes dryer", "dryer", "tumble dryer"): ("clothes_dryer",),
+     "table light", "task lamp", "task light", "bankers lamp"): ("desk_lamp", "lamp"),
+    ("coffee machine", "coffee maker", "espresso machine", "coffeemaker", "coffee brewer", "espresso maker", "percolator", "keurig", "nespresso"): ("coffee_machine",),
+    ("washing machine", "washer", "laundry machine", "clothes washer", "washer machine", "front loader"): ("washing_machine",),
+    ("clothes dryer", "dryer", "tumble dryer", "tumble drier", "drier", "clothes drier", "dryer machine"): ("clothes_dryer",),
     ("dresser", "chest of drawers", "drawers", "chest", "wardrobe", "closet", "bureau", "dressing table",
-     "tallboy"): ("dresser",),
+     "tallboy", "highboy", "lowboy"): ("dresser",),
     ("alarm clock",): ("alarm_clock", "clock"),
     ("clock", "wall clock"): ("clock",),
     ("teddy bear", "teddy", "stuffed animal", "plush toy", "soft toy", "plushie", "plush", "stuffed toy",
      "stuffed bear"): ("teddy_bear",),
-    ("stool", "bar stool", "step stool"): ("stool",),
+    ("stool", "bar stool", "step stool", "barstool", "kitchen stool", "counter stool"): ("stool",),
     ("ottoman", "pouf", "pouffe", "footstool", "foot stool", "footrest"): ("ottoman", "footstool"),
     ("oven", "cooker", "range"): ("oven", "stove"),
-    ("stove", "stovetop", "hob", "cooktop", "stove burner"): ("stove", "oven"),
+    ("stove", "stovetop", "hob", "cooktop", "stove burner", "stove top"): ("stove", "oven"),
     ("microwave", "microwave oven"): ("microwave",),
-    ("laptop", "notebook computer", "laptop computer", "computer", "macbook", "laptop pc", "notebook pc"): ("laptop",),
+    ("laptop", "notebook computer", "laptop computer", "computer", "macbook", "laptop pc", "notebook pc", "chromebook", "ultrabook"): ("laptop",),
     ("mug", "coffee mug", "tea mug"): ("mug", "cup"),
-    ("cup", "teacup", "tea cup", "coffee cup", "glass", "drinking glass"): ("cup", "mug"),
+    ("cup", "teacup", "tea cup", "coffee cup", "glass", "drinking glass", "wine glass", "wineglass", "tumbler"): ("cup", "mug"),
     ("bottle", "water bottle"): ("bottle",),
     ("wine bottle", "bottle of wine"): ("wine_bottle", "bottle"),
     ("vase", "flower vase"): ("vase",),
@@ -132,9 +132,9 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("hand towel",): ("hand_towel", "towel"),
     ("tv stand", "tv cabinet", "media console", "entertainment center", "tv unit",
      "television stand", "tv console", "tv bench", "tv table", "entertainment unit", "media unit",
-     "entertainment centre"): ("tv_stand",),
+     "entertainment centre", "media cabinet", "television cabinet", "television unit", "media stand", "tv sideboard"): ("tv_stand",),
     ("garbage bag", "trash bag", "bin bag"): ("garbage_bag",),
-    ("laundry hamper", "laundry basket", "hamper", "clothes basket"): ("laundry_hamper",),
+    ("laundry hamper", "laundry basket", "hamper", "clothes basket", "linen basket", "washing basket", "laundry bin", "linen hamper"): ("laundry_hamper",),
     ("toilet paper", "toilet roll", "loo roll", "bathroom tissue"): ("toilet_paper",),
     ("paper towel roll", "paper towel", "kitchen roll", "paper towels"): ("paper_towel_roll",),
     ("tissue box", "tissues", "kleenex"): ("tissue_box",),
@@ -149,24 +149,28 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("window", "windows"): ("window",),
     ("door", "doorway", "front door"): ("door",),
     ("mirror", "wall mirror"): ("mirror",),
-    ("rug", "carpet", "mat"): ("rug",),
+    ("rug", "carpet", "mat", "doormat", "door mat", "bath mat", "bathmat", "floor mat", "area rug"): ("rug",),
     ("curtains", "curtain", "drapes"): ("curtains",),
     ("cabinet", "cupboard", "kitchen cabinet"): ("cabinet",),
-    ("dog bed", "pet bed"): ("dog_bed",),
+    ("dog bed", "pet bed", "dog basket", "dog cushion", "pet cushion", "cat bed", "doggy bed", "dog mattress", "pet basket", "cat basket"): ("dog_bed",),
     ("vacuum cleaner", "vacuum", "hoover"): ("vacuum_cleaner",),
     ("box", "cardboard box", "carton"): ("box",),
-    ("statue", "sculpture", "figurine", "statuette", "bust", "figure", "decorative figure"): ("statue",),
+    ("statue", "sculpture", "figurine", "statuette", "bust", "figure", "decorative figure", "carving"): ("statue",),
     ("candle", "candles"): ("candle",),
     ("watering can",): ("watering_can",),
-    ("spray bottle",): ("spray_bottle",),
+    ("spray bottle", "spray", "cleaning spray", "spritzer"): ("spray_bottle",),
     ("basketball", "basket ball"): ("basket_ball",),
+    ("salt", "salt cellar"): ("salt_shaker",),
     ("baseball bat",): ("baseball_bat",),
     ("tennis racket", "tennis racquet", "racket"): ("tennis_racket",),
     ("dumbbell", "weight", "weights"): ("dumbbell",),
     ("newspaper", "paper", "magazine"): ("newspaper",),
-    ("key chain", "keychain", "keys", "key"): ("key_chain",),
+    ("key chain", "keychain", "keys", "key", "key ring", "keyring"): ("key_chain",),
     ("credit card", "bank card"): ("credit_card",),
     ("desktop", "desktop computer", "pc", "monitor", "computer monitor"): ("desktop",),
+    ("safe", "strongbox", "strong box", "lockbox", "lock box", "safe box", "safety box", "deposit box",
+     "safety deposit box", "vault", "wall safe"): ("safe",),
+    ("watch", "wristwatch", "wrist watch"): ("watch",),
 }
 
 ROOMS: dict[str, str] = {
@@ -369,9 +373,16 @@ _IRREGULAR_PLURALS = {"knives": "knife", "shelves": "shelves", "bookshelves": "b
                       "brushes": "brush", "glass": "glass", "tv": "tv", "bus": "bus"}
 
 
+# nouns that are plural only: "the scissors" is one pair, never a "scissor"
+PLURAL_ONLY = frozenset(["scissors", "sunglasses", "spectacles", "binoculars", "pliers", "tongs", "goggles",
+                         "shorts", "trousers", "pants", "jeans", "headphones", "earphones", "tweezers"])
+
+
 def _singular(word: str) -> str:
     if word in _IRREGULAR_PLURALS:
         return _IRREGULAR_PLURALS[word]
+    if word in PLURAL_ONLY:
+        return word
     if len(word) <= 3 or word.endswith(("ss", "us", "is", "ous")):
         return word
     if word.endswith("ies"):
@@ -394,6 +405,23 @@ def _room_modifier(words: Sequence[str]) -> tuple[list[str], str | None]:
             if phrase in ROOMS:
                 return words[:i] + words[i + n:], ROOMS[phrase]
     return words, None
+
+
+def _other_kind(phrase: str, label: str) -> bool:
+    """Whether the spaced ``label`` names another kind of thing than ``phrase`` although their
+    words overlap: they share a word but not their last (the head noun: "basket" and "basket
+    ball", "bell pepper" and "pepper shaker", "wine" and "wine bottle"), or one word begins with
+    the other ("doormat" and "door"). Sentence embedders score such pairs high on their spelling;
+    a synonym shares no word (couch, sofa) or its head (tv unit, tv stand)."""
+    a, b = phrase.split(), label.split()
+    if not a or not b:
+        return False
+    if set(a) & set(b) and a[-1] != b[-1]:
+        return True
+    x, y = _singular(a[0]), _singular(b[0])
+    if len(a) == 1 and len(b) == 1 and x != y:
+        return x.startswith(y) or y.startswith(x)
+    return False
 
 
 def _spaced(label: str) -> str:
@@ -615,7 +643,7 @@ class OfflineParser:
         if hit is not None:
             return hit, True
         best, score = self._most_similar(phrase)
-        if best is not None and score >= self.threshold:
+        if best is not None and score >= self.threshold and not _other_kind(phrase, _spaced(best)):
             return best, True
         words = phrase.split()
         if words:
@@ -630,6 +658,8 @@ class OfflineParser:
         # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
+        # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
+        text = re.sub(r"\b(?:[a-z]\.){2,}", lambda m: m.group(0).replace(".", "") + " ", text)
         parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"
                          r"(?:find|look|go|search|locate|navigate|take|walk|head|bring|show|get)\b)"
                          r"|\s+and\s+(?=(?:find|look for|search for|locate)\b)", text)
