@@ -35,12 +35,16 @@ import argparse
 import json
 import re
 import sys
+import zlib
 from pathlib import Path
 
 from hiconav.reasoning.config import ReasoningConfig
-from hiconav.reasoning.decompose import decompose_instruction
+from hiconav.reasoning.decompose import _singular, decompose_instruction
 from hiconav.reasoning.grounding import target_relations
 from hiconav.sim.task_episodes import TEXTNAV_PHRASINGS, _article, spoken
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ovon_names import NAMES  # noqa: E402  (benchmarks/ is no package)
 
 # the generator's leading words ("take me to the "), read off its templates
 LEAD = re.compile("^(?:" + "|".join(re.escape(p.split("{np}")[0]) for p in TEXTNAV_PHRASINGS) + ")",
@@ -49,6 +53,13 @@ ROOM = re.compile(r"in the (kitchen|living room|bedroom|bathroom)")
 # descriptions that may be said relation first ("Next to the fridge, there's a chair."): one
 # relation phrase, then its object
 FRONTABLE = re.compile(r"(?:in|on|on top of|next to|beside|by|near|under|below|beneath|above|close to) the [a-z ]+")
+
+
+def other_names(target: str) -> list[str]:
+    """Names people give ``target`` beyond the generator's (``ovon_names.NAMES``), singular and
+    without a preposition of their own ("the lamp on the desk" is a description, not a name)."""
+    return [n for n in NAMES.get(target, ()) if _singular(n.split()[-1]) == n.split()[-1]
+            and not {"on", "for", "of"} & set(n.split())]
 
 
 def forms(instruction: str, target: str) -> dict[str, str]:
@@ -68,6 +79,10 @@ def forms(instruction: str, target: str) -> dict[str, str]:
         "bare": f"the {name} {rest}, please",
     }
     out["dash"] = f"the {name} {rest} - go there"
+    others = other_names(target)
+    if others:
+        other = others[zlib.crc32(instruction.encode()) % len(others)]
+        out["other name"] = f"take me to the {other} {rest}"
     if FRONTABLE.match(rest):
         first = rest[0].upper() + rest[1:]
         out["relation first"] = f"{first}, there's {_article(name)} {name}. Take me to it."
@@ -106,6 +121,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=int, default=30, help="houses to generate episodes in")
     ap.add_argument("--show", type=int, default=10, help="phrasings read differently to print")
     ap.add_argument("--write", help="write the episodes with one people's form each (needs --episodes)")
+    ap.add_argument("--form", help="with --write: this form for every episode where it applies "
+                    "(e.g. 'other name'); default: the room word or follow-up, and the relative clause")
     args = ap.parse_args(argv)
     if args.write and not args.episodes:
         ap.error("--write needs --episodes")
@@ -148,7 +165,9 @@ def main(argv: list[str] | None = None) -> int:
         with open(args.write, "w") as out:
             for i, ep in enumerate(eps):
                 fs = forms(ep["instruction"], ep["target"])
-                if fs:
+                if fs and args.form:
+                    ep = dict(ep, instruction=fs.get(args.form, ep["instruction"]))
+                elif fs:
                     even = fs.get("room word", fs["follow-up"])
                     ep = dict(ep, instruction=even if i % 2 == 0 else fs["relative clause"])
                 out.write(json.dumps(ep) + "\n")

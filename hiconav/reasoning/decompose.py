@@ -75,14 +75,14 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
      "ficus", "palm", "palm tree", "monstera", "bonsai", "orchid", "indoor tree", "potted tree", "greenery"):
         ("plant", "potted_plant", "house_plant"),
     ("fridge", "refrigerator", "freezer", "icebox"): ("fridge", "refrigerator"),
-    ("dining table", "dinner table", "kitchen table", "dining-table", "table", "eating table"):
+    ("dining table", "dinner table", "kitchen table", "dining-table", "table", "eating table", "dining room table"):
         ("table", "dining_table"),
     ("side table", "nightstand", "night stand", "bedside table", "night table", "end table",
      "bedside cabinet", "occasional table", "accent table", "lamp table", "bedside stand"): ("side_table", "nightstand"),
     ("coffee table", "cocktail table", "tea table", "low table"): ("coffee_table",),
     ("desk", "writing desk", "office desk", "computer desk", "work desk", "workstation", "writing table", "study table", "computer table", "work table", "worktable", "secretary desk"): ("desk",),
     ("chair", "dining chair", "kitchen chair", "office chair", "desk chair", "wooden chair",
-     "seat"): ("chair",),
+     "seat", "dining room chair"): ("chair",),
     ("armchair", "arm chair", "recliner", "easy chair", "lounge chair", "accent chair", "wingback",
      "wingback chair", "wing chair", "club chair", "reading chair"):
         ("armchair", "arm_chair", "chair"),

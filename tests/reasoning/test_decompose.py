@@ -463,3 +463,13 @@ def test_the_embedder_does_not_turn_a_name_into_a_compound_that_holds_it() -> No
     assert p.parse("find the doormat").targets == ("doormat",)
     assert p.parse("find the armoire").targets == ("dresser",)
     assert p.parse("find the table top").targets == ("counter_top",)
+
+
+def test_a_room_word_that_names_the_kind_places_nothing(parser) -> None:
+    # "the dining room table" is a dining table wherever it stands (houses without a dining room
+    # have them), as "the kitchen sink" is a sink; "the bedroom tv" is a tv in the bedroom
+    task = parser.parse("take me to the dining room table in the kitchen")
+    assert task.targets == ("dining_table",)
+    assert task.relations == (("dining_table", "in", "kitchen"),)
+    assert parser.parse("find the dining room chair").relations == ()
+    assert parser.parse("find the bedroom tv").relations == (("tv", "in", "bedroom"),)
