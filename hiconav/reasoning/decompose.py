@@ -304,6 +304,19 @@ go look for|go and look for|hey robot|hi robot|hello robot|ok robot|okay robot|h
 by the way|anyway|btw|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
+# "I'm hungry, ...", "I am so tired": the speaker's state, before what they ask
+SPEAKER_STATE = re.compile(
+    r"^(?:i'm|i am|we're|we are|i feel|i'm feeling|i am feeling)\s+(?:so |very |really |a bit |kind of )?"
+    r"(?:hungry|thirsty|tired|sleepy|cold|hot|bored|dirty|sweaty|exhausted|lost)(?:\s*,\s*|$)")
+# "I want to sit on the sofa", "let me lie down on the bed", "I'd like to wash my hands at the
+# sink": an activity at an object; the object is where to go
+ACTIVITY = re.compile(
+    r"^(?:i want to|i wanna|i'd like to|i would like to|i'd love to|i would love to|i need to|i have to|"
+    r"we want to|we need to|let me|let's|let us|i'm going to|i am going to)\s+"
+    r"(?:sit|lie|lay|sleep|rest|relax|nap|wash|cook|eat|work|study|stand|put|place|leave)"
+    r"(?:\s+(?:down|up|back|over))?(?:\s+(?:my|our|the|this|these|it|them)(?:\s+[a-z']+)?)??"
+    r"\s+(?:on|in|at|by|near|into|onto|next to|on top of)\s+")
+
 # Relation phrases -> canonical relation (longest match first).
 RELATIONS: dict[str, str] = {
     "in front of": "in front of", "to the left of": "left of", "on the left of": "left of",
@@ -667,7 +680,13 @@ class OfflineParser:
         for part in parts:
             part = re.sub(r"[^a-z0-9' \-,]", " ", part)
             part = part.replace(",", " , ").replace("-", " ")
+            # who it is for names no object: "locate the coffee maker for me"
+            part = re.sub(r"\bfor (?:me|us|myself)\b", " ", part)
             part = " ".join(part.split())
+            # how the speaker feels names no object ("I'm hungry, take me to the fridge"); what
+            # they want to do at an object names it ("I'd love to sit on the sofa")
+            part = SPEAKER_STATE.sub("", part).strip()
+            part = ACTIVITY.sub("go to ", part)
             if part:
                 out.append(part)
         return out

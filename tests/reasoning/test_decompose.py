@@ -473,3 +473,26 @@ def test_a_room_word_that_names_the_kind_places_nothing(parser) -> None:
     assert task.relations == (("dining_table", "in", "kitchen"),)
     assert parser.parse("find the dining room chair").relations == ()
     assert parser.parse("find the bedroom tv").relations == (("tv", "in", "bedroom"),)
+
+
+@pytest.mark.parametrize("text,target", [
+    ("Could you locate the coffee maker for me?", "coffee_machine"),  # who it is for is no object
+    ("I'm hungry, take me to the fridge", "fridge"),  # the speaker's state was read as the target
+    ("I'm so tired, the bed please", "bed"),
+    ("I'd love to sit on the sofa, take me there", "sofa"),  # an activity at an object: go to it
+    ("I want to lie down on the bed", "bed"),
+    ("I'd like to wash my hands at the sink", "sink"),
+    ("let me sit on the couch", "sofa"),
+    ("I need to sit down on a chair", "chair"),
+])
+def test_what_the_speaker_feels_or_wants_to_do_names_where_to_go(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == ()
+
+
+def test_an_activity_keeps_the_description_of_its_object(parser) -> None:
+    task = parser.parse("I want to sit on the chair next to the window")
+    assert task.targets == ("chair",)
+    assert task.relations == (("chair", "next to", "window"),)
+    assert parser.parse("I'm looking for the chair next to the fridge").targets == ("chair",)
