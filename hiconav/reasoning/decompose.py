@@ -330,7 +330,11 @@ RELATIONS: dict[str, str] = {
     "inside of": "in", "within": "in", "in": "in", "at": "at", "between": "between",
     "among": "between", "with": "with", "against": "against", "opposite": "opposite",
     "opposite to": "opposite", "across from": "opposite", "facing": "facing",
-    "around": "near", "from": "near",
+    "around": "near", "from": "near", "close by": "near", "up against": "against",
+    # how furniture was put there: "the chair pulled up to the table", "tucked under the desk"
+    "pulled up to": "next to", "pushed up to": "next to", "drawn up to": "next to",
+    "pushed against": "against", "pushed up against": "against", "tucked under": "under",
+    "tucked into": "under",
     # superlatives ("the chair closest to the fridge") read as near: which of several is the
     # closest needs every one of them seen, near is what a single view can check
     "closest to": "near", "nearest to": "near", "nearest the": "near", "closer to": "near", "nearer to": "near",
@@ -579,10 +583,12 @@ class OfflineParser:
                     continue
                 phrases = self._noun_phrases(np_words)
                 for p in phrases:
-                    if p.room and relation not in CONTAINMENT:
+                    # "the painting on the wall of the bedroom": on a part of a room is in it
+                    rel = "in" if p.room and p.text.split()[0] in PLACE_NOUNS and " of " in p.text else relation
+                    if p.room and rel not in CONTAINMENT:
                         # "the toilet in the bathroom next to the bedroom": where a room lies is
                         # not a relation of the object, and names no room it is in
-                        log.info("relation %r to the room %r not kept: not a containment", relation, p.room)
+                        log.info("relation %r to the room %r not kept: not a containment", rel, p.room)
                         continue
                     if not p.room and p.label in PLACE_NOUNS:
                         # "the plant in the corner": a part of a room, no object a detector
@@ -592,7 +598,7 @@ class OfflineParser:
                         continue
                     for subj in previous[:1]:
                         if subj.label not in PLACE_NOUNS or subj in targets:
-                            relations.append((subj.label, relation, p.room or p.label))
+                            relations.append((subj.label, rel, p.room or p.label))
                     if p.room:
                         rooms.append(p.room)
                     else:

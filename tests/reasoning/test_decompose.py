@@ -496,3 +496,16 @@ def test_an_activity_keeps_the_description_of_its_object(parser) -> None:
     assert task.targets == ("chair",)
     assert task.relations == (("chair", "next to", "window"),)
     assert parser.parse("I'm looking for the chair next to the fridge").targets == ("chair",)
+
+
+@pytest.mark.parametrize("text,relations", [
+    ("the chair pulled up to the dining table", (("chair", "next to", "dining_table"),)),  # sought the table
+    ("the chair tucked under the desk", (("chair", "under", "desk"),)),
+    ("the chair close by the fridge", (("chair", "near", "fridge"),)),  # a "chair_close"
+    ("the painting on the wall of the bedroom", (("painting", "in", "bedroom"),)),  # the room was lost
+    ("the plant on the floor of the kitchen", (("plant", "in", "kitchen"),)),
+])
+def test_how_furniture_stands_and_where_a_part_of_a_room_is(parser, text, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (relations[0][0],)
+    assert task.relations == relations
