@@ -304,6 +304,11 @@ go look for|go and look for|hey robot|hi robot|hello robot|ok robot|okay robot|h
 by the way|anyway|btw|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
+# a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
+FINAL_COMMAND = re.compile(
+    r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?(?:stop|wait|stay|halt|remain)"
+    r"(?:\s+(?:there|here|next to it|by it|in front of it|beside it|when you get there|when you arrive|"
+    r"once you are there|once you get there))?(?:\s+please)?\s*[.!]*\s*$")
 # "I'm hungry, ...", "I am so tired": the speaker's state, before what they ask
 SPEAKER_STATE = re.compile(
     r"^(?:i'm|i am|we're|we are|i feel|i'm feeling|i am feeling)\s+(?:so |very |really |a bit |kind of )?"
@@ -677,6 +682,8 @@ class OfflineParser:
         # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
+        # what to do on arrival names no object: "go to the chair by the fridge and stop there"
+        text = FINAL_COMMAND.sub("", text)
         # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
         text = re.sub(r"\b(?:[a-z]\.){2,}", lambda m: m.group(0).replace(".", "") + " ", text)
         parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"

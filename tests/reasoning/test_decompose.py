@@ -509,3 +509,16 @@ def test_how_furniture_stands_and_where_a_part_of_a_room_is(parser, text, relati
     task = parser.parse(text)
     assert task.targets == (relations[0][0],)
     assert task.relations == relations
+
+
+@pytest.mark.parametrize("text", [
+    "Could you find the chair by the fridge and stop there", "go to the chair next to the fridge and wait",
+    "go to the chair next to the fridge and stop", "the chair by the fridge, wait there",
+])
+def test_what_to_do_on_arrival_names_no_object(parser, text) -> None:
+    # "... and stop" was read as a second object the chair stands next to: a relation no view
+    # could ever confirm
+    task = parser.parse(text)
+    assert task.targets == ("chair",)
+    assert task.relations == (("chair", "next to", "fridge"),)
+    assert parser.parse("go to the bus stop").targets == ("bus_stop",)
