@@ -302,6 +302,7 @@ the target is|target|your goal is|the goal is|goal|object|it is|it's|there is|th
 take me over to|bring me over to|come over to|look around for|search around for|have a look for|
 go look for|go and look for|hey robot|hi robot|hello robot|ok robot|okay robot|hey|hi|hello|
 by the way|anyway|btw|
+go into|go in|head into|walk into|get into|enter|look in|look inside|search in|check in|check|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
@@ -309,6 +310,9 @@ FINAL_COMMAND = re.compile(
     r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?(?:stop|wait|stay|halt|remain)"
     r"(?:\s+(?:there|here|next to it|by it|in front of it|beside it|when you get there|when you arrive|"
     r"once you are there|once you get there))?(?:\s+please)?\s*[.!]*\s*$")
+FINAL_COURTESY = re.compile(
+    r"(?:,?\s*\b(?:please|pls|plz|thanks|thank you|thanks a lot|thx|ty|cheers|asap|quickly|right away|"
+    r"immediately|straight away|now|real quick))+\s*[.!]*\s*$")
 # "I'm hungry, ...", "I am so tired": the speaker's state, before what they ask
 SPEAKER_STATE = re.compile(
     r"^(?:i'm|i am|we're|we are|i feel|i'm feeling|i am feeling)\s+(?:so |very |really |a bit |kind of )?"
@@ -682,8 +686,10 @@ class OfflineParser:
         # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
-        # what to do on arrival names no object: "go to the chair by the fridge and stop there"
+        # what to do on arrival names no object: "go to the chair by the fridge and stop there";
+        # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
         text = FINAL_COMMAND.sub("", text)
+        text = FINAL_COURTESY.sub("", text)
         # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
         text = re.sub(r"\b(?:[a-z]\.){2,}", lambda m: m.group(0).replace(".", "") + " ", text)
         parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"

@@ -522,3 +522,17 @@ def test_what_to_do_on_arrival_names_no_object(parser, text) -> None:
     assert task.targets == ("chair",)
     assert task.relations == (("chair", "next to", "fridge"),)
     assert parser.parse("go to the bus stop").targets == ("bus_stop",)
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    ("look in the kitchen for the fridge", "fridge", (("fridge", "in", "kitchen"),)),  # sought a "look"
+    ("head into the living room and locate the couch", "sofa", (("sofa", "in", "living_room"),)),
+    ("go into the bathroom and find the toilet", "toilet", (("toilet", "in", "bathroom"),)),  # room lost
+    ("find the bed thx", "bed", ()),  # a "bed_thx"
+    ("go to the bed asap", "bed", ()),
+    ("go find a tv please thanks", "tv", ()),
+])
+def test_going_into_a_room_and_courtesies_at_the_end(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
