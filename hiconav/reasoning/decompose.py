@@ -303,6 +303,7 @@ take me over to|bring me over to|come over to|look around for|search around for|
 go look for|go and look for|hey robot|hi robot|hello robot|ok robot|okay robot|hey|hi|hello|
 by the way|anyway|btw|
 go into|go in|head into|walk into|get into|enter|look in|look inside|search in|check in|check|
+do we have|do you have|have we got|is there|are there|can you see|do you see|what about|how about|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
@@ -310,6 +311,8 @@ FINAL_COMMAND = re.compile(
     r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?(?:stop|wait|stay|halt|remain)"
     r"(?:\s+(?:there|here|next to it|by it|in front of it|beside it|when you get there|when you arrive|"
     r"once you are there|once you get there))?(?:\s+please)?\s*[.!]*\s*$")
+# why the speaker asks, at the end: "bring me to the tv so I can watch the news"
+PURPOSE = re.compile(r",?\s+(?:so that|so|because|since|in order that)\s+(?:i|we|i'd|we'd|i'm|we're)\b[^.!?;]*")
 FINAL_COURTESY = re.compile(
     r"(?:,?\s*\b(?:please|pls|plz|thanks|thank you|thanks a lot|thx|ty|cheers|asap|quickly|right away|"
     r"immediately|straight away|now|real quick))+\s*[.!]*\s*$")
@@ -688,6 +691,7 @@ class OfflineParser:
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
         # what to do on arrival names no object: "go to the chair by the fridge and stop there";
         # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
+        text = PURPOSE.sub("", text)
         text = FINAL_COMMAND.sub("", text)
         text = FINAL_COURTESY.sub("", text)
         # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences

@@ -536,3 +536,17 @@ def test_going_into_a_room_and_courtesies_at_the_end(parser, text, target, relat
     task = parser.parse(text)
     assert task.targets == (target,)
     assert task.relations == relations
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    ("Do we have a microwave?", "microwave", ()),  # a "do_we" with a microwave
+    ("Can you see a plant?", "plant", ()),
+    ("bring me to the tv so I can watch the news", "tv", ()),  # a "tv_so_i_can_watch_new"
+    ("take me to the bed because I'm tired", "bed", ()),
+    ("the chair next to the fridge so I can sit there", "chair", (("chair", "next to", "fridge"),)),
+])
+def test_questions_about_the_house_and_reasons_name_only_the_object(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert not task.attributes
