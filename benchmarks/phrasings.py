@@ -7,8 +7,10 @@ chair ..."), a follow-up sentence ("Find the chair. The one
 next to the fridge."), a relative clause ("the chair that is next to the fridge"), a polite
 lead ("I'd like to go to ..."), the relation first ("Next to the fridge, there's a chair. Take me
 to it."), a room in the possessive ("the kitchen's chair"), a dashed afterthought ("the chair
-next to the fridge - go there"). A parser that reads only the templates loses the description
-and stops at the first instance of the category it sees.
+next to the fridge - go there"), the target called by another name, what to do on arrival
+("... and stop there"), the speaker's reason ("... so I can have a look, thanks"). A parser that
+reads only the templates loses the description and stops at the first instance of the category
+it sees.
 
 For each textnav instruction the script writes every form below that applies, decomposes the
 template and each form offline (``decompose_instruction``, MiniLM similarity) and counts a form as
@@ -79,6 +81,8 @@ def forms(instruction: str, target: str) -> dict[str, str]:
         "bare": f"the {name} {rest}, please",
     }
     out["dash"] = f"the {name} {rest} - go there"
+    out["arrival"] = f"Could you find the {name} {rest} and stop there"
+    out["reason"] = f"bring me to the {name} {rest} so I can have a look, thanks"
     others = other_names(target)
     if others:
         other = others[zlib.crc32(instruction.encode()) % len(others)]
