@@ -346,7 +346,14 @@ RELATIONS: dict[str, str] = {
     # how furniture was put there: "the chair pulled up to the table", "tucked under the desk"
     "pulled up to": "next to", "pushed up to": "next to", "drawn up to": "next to",
     "pushed against": "against", "pushed up against": "against", "tucked under": "under",
-    "tucked into": "under",
+    "tucked into": "under", "tucked beneath": "under", "tucked behind": "behind",
+    # nearness said in other words ("the chair in the vicinity of the fridge")
+    "by the side of": "next to", "at the side of": "next to", "to the side of": "next to",
+    "close beside": "next to", "neighbouring": "next to", "neighboring": "next to", "adjoining": "next to",
+    "next door to": "next to", "adjacent": "next to", "bordering": "next to", "flanking": "next to",
+    "abutting": "next to", "in the vicinity of": "near", "in proximity to": "near",
+    "in close proximity to": "near", "not far from": "near", "a few steps from": "near",
+    "a little way from": "near", "a short distance from": "near", "within reach of": "near",
     # superlatives ("the chair closest to the fridge") read as near: which of several is the
     # closest needs every one of them seen, near is what a single view can check
     "closest to": "near", "nearest to": "near", "nearest the": "near", "closer to": "near", "nearer to": "near",
@@ -380,6 +387,7 @@ FILLERS = frozenset([
     "resting", "rests", "there", "it's", "its", "just", "right", "directly", "somewhere", "usually",
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
+    "immediately", "straight", "exactly",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",

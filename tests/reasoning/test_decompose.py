@@ -550,3 +550,17 @@ def test_questions_about_the_house_and_reasons_name_only_the_object(parser, text
     assert task.targets == (target,)
     assert task.relations == relations
     assert not task.attributes
+
+
+@pytest.mark.parametrize("phrase,relation", [
+    ("neighbouring", "next to"), ("adjoining", "next to"), ("next door to", "next to"),  # sought the fridge
+    ("bordering", "next to"), ("flanking", "next to"), ("adjacent", "next to"),
+    ("tucked beneath", "under"), ("immediately next to", "next to"), ("close beside", "next to"),  # "chair_tucked", ...
+    ("straight above", "above"), ("a few steps from", "near"), ("a little way from", "near"),
+    ("by the side of", "next to"), ("at the side of", "next to"), ("not far from", "near"),  # relation lost
+    ("in the vicinity of", "near"), ("in proximity to", "near"), ("within reach of", "near"),  # in a "vicinity"
+])
+def test_relations_said_in_other_words(parser, phrase, relation) -> None:
+    task = parser.parse(f"find the chair {phrase} the fridge")
+    assert task.targets == ("chair",)
+    assert task.relations == (("chair", relation, "fridge"),)
