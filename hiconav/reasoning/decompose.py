@@ -181,6 +181,13 @@ ROOMS: dict[str, str] = {
     "hallway": "hallway", "hall": "hallway", "corridor": "hallway", "office": "office",
     "study": "office", "laundry room": "laundry_room", "laundry": "laundry_room",
     "garage": "garage", "nursery": "bedroom", "guest room": "bedroom", "master bedroom": "bedroom",
+    # other names people give the rooms
+    "guest bedroom": "bedroom", "primary bedroom": "bedroom", "main bedroom": "bedroom", "spare room": "bedroom",
+    "kids room": "bedroom", "kids' room": "bedroom", "kid's room": "bedroom", "children's room": "bedroom",
+    "childrens room": "bedroom", "den": "living_room", "tv room": "living_room", "front room": "living_room",
+    "utility room": "laundry_room", "powder room": "bathroom", "ensuite": "bathroom", "en suite": "bathroom",
+    "shower room": "bathroom", "entryway": "hallway", "foyer": "hallway", "entrance hall": "hallway",
+    "kitchenette": "kitchen",
     # "the fridge in the kitchen area": an area named after a room is that room
     "kitchen area": "kitchen", "living area": "living_room", "sitting area": "living_room",
     "lounge area": "living_room", "dining area": "dining_room", "sleeping area": "bedroom",
@@ -343,6 +350,7 @@ RELATIONS: dict[str, str] = {
     "among": "between", "with": "with", "against": "against", "opposite": "opposite",
     "opposite to": "opposite", "across from": "opposite", "facing": "facing",
     "around": "near", "from": "near", "close by": "near", "up against": "against",
+    "out in": "in", "down in": "in", "up in": "in", "over in": "in", "back in": "in",
     # how furniture was put there: "the chair pulled up to the table", "tucked under the desk"
     "pulled up to": "next to", "pushed up to": "next to", "drawn up to": "next to",
     "pushed against": "against", "pushed up against": "against", "tucked under": "under",
@@ -387,7 +395,7 @@ FILLERS = frozenset([
     "resting", "rests", "there", "it's", "its", "just", "right", "directly", "somewhere", "usually",
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
-    "immediately", "straight", "exactly",
+    "immediately", "straight", "exactly", "upstairs", "downstairs",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -843,7 +851,7 @@ class OfflineParser:
         # "between the sofa and the tv": keep both in one segment; drop fillers everywhere.
         cleaned = []
         for rel, seg in segments:
-            seg = [w for w in seg if w not in FILLERS]
+            seg = [w for k, w in enumerate(seg) if w not in FILLERS or " ".join(seg[k:k + 2]) in ROOMS]
             if rel or seg:
                 cleaned.append((rel, seg))
         if not cleaned or cleaned[0][0] != "":
@@ -879,7 +887,9 @@ class OfflineParser:
         for stop in NEGATIONS:
             if stop in words:
                 words = words[:words.index(stop)]
-        words = [w for w in words if w not in DETERMINERS and w not in FILLERS and w not in PRONOUNS
+        # a filler word that names a room with the next word stays ("the sitting room")
+        words = [w for i, w in enumerate(words) if w not in DETERMINERS and w not in PRONOUNS
+                 and (w not in FILLERS or " ".join(words[i:i + 2]) in ROOMS)
                  and not w.isdigit()]
         # "a bottle of wine" -> "bottle" (the head comes before "of"), unless "of" is in a name.
         if "of" in words:

@@ -564,3 +564,18 @@ def test_relations_said_in_other_words(parser, phrase, relation) -> None:
     task = parser.parse(f"find the chair {phrase} the fridge")
     assert task.targets == ("chair",)
     assert task.relations == (("chair", relation, "fridge"),)
+
+
+@pytest.mark.parametrize("where,room", [
+    ("in the guest bedroom", "bedroom"), ("in the den", "living_room"), ("in the tv room", "living_room"),
+    ("in the utility room", "laundry_room"), ("in the powder room", "bathroom"), ("in the ensuite", "bathroom"),
+    ("in the spare room", "bedroom"), ("in the kids' room", "bedroom"), ("in the foyer", "hallway"),
+    ("in the kitchenette", "kitchen"), ("in the sitting room", "living_room"),  # "sitting" was dropped as a filler
+    ("out in the living room", "living_room"), ("up in the bedroom", "bedroom"),  # a "plant_out", a "plant_up"
+    ("in the bedroom upstairs", "bedroom"),
+])
+def test_other_names_of_the_rooms(parser, where, room) -> None:
+    # a room read as an object label ("guest_bedroom") is a relation no view can ever confirm
+    task = parser.parse(f"find the plant {where}")
+    assert task.targets == ("plant",)
+    assert ("plant", "in", room) in task.relations
