@@ -146,7 +146,7 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("kettle", "tea kettle", "electric kettle"): ("kettle",),
     ("plate", "dish", "dinner plate"): ("plate",),
     ("bowl", "salad bowl", "cereal bowl"): ("bowl",),
-    ("window", "windows"): ("window",),
+    ("window", "windows", "windowsill", "window sill", "window ledge", "sill"): ("window",),
     ("door", "doorway", "front door"): ("door",),
     ("mirror", "wall mirror"): ("mirror",),
     ("rug", "carpet", "mat", "doormat", "door mat", "bath mat", "bathmat", "floor mat", "area rug"): ("rug",),

@@ -579,3 +579,8 @@ def test_other_names_of_the_rooms(parser, where, room) -> None:
     task = parser.parse(f"find the plant {where}")
     assert task.targets == ("plant",)
     assert ("plant", "in", room) in task.relations
+
+
+def test_a_windowsill_is_the_window(parser) -> None:
+    # "windowsill" was a label no detector gives: a relation no view could confirm
+    assert parser.parse("the houseplant on the windowsill").relations == (("plant", "on", "window"),)
