@@ -395,7 +395,7 @@ FILLERS = frozenset([
     "resting", "rests", "there", "it's", "its", "just", "right", "directly", "somewhere", "usually",
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
-    "immediately", "straight", "exactly", "upstairs", "downstairs",
+    "immediately", "straight", "exactly", "upstairs", "downstairs", "but",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -708,6 +708,9 @@ class OfflineParser:
         # what to do on arrival names no object: "go to the chair by the fridge and stop there";
         # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
         text = PURPOSE.sub("", text)
+        # a side with nothing it is the side of ("the chair to the left") is the viewer's: no
+        # object, and no relation a map can check
+        text = re.sub(r"\s+(?:to|on) the (?:left|right)(?:\s+(?:hand\s+)?side)?\b(?!\s+(?:of|side)\b)", "", text)
         text = FINAL_COMMAND.sub("", text)
         text = FINAL_COURTESY.sub("", text)
         # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences

@@ -584,3 +584,16 @@ def test_other_names_of_the_rooms(parser, where, room) -> None:
 def test_a_windowsill_is_the_window(parser) -> None:
     # "windowsill" was a label no detector gives: a relation no view could confirm
     assert parser.parse("the houseplant on the windowsill").relations == (("plant", "on", "window"),)
+
+
+@pytest.mark.parametrize("text,relations", [
+    ("find a chair but not in the kitchen", ()),  # a "chair_but"
+    ("the chair but the one by the fridge", (("chair", "next to", "fridge"),)),
+    ("the chair to the left", ()),  # a "chair_to_left": the viewer's left is no relation a map checks
+    ("the chair on the right, next to the fridge", (("chair", "next to", "fridge"),)),
+    ("the chair on the left of the fridge", (("chair", "left of", "fridge"),)),
+])
+def test_but_and_a_side_of_nothing(parser, text, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == ("chair",)
+    assert task.relations == relations
