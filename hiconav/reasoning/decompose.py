@@ -705,12 +705,13 @@ class OfflineParser:
         # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
-        # what to do on arrival names no object: "go to the chair by the fridge and stop there";
-        # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
+        # why the speaker asks names no object ("bring me to the tv so I can watch the news")
         text = PURPOSE.sub("", text)
         # a side with nothing it is the side of ("the chair to the left") is the viewer's: no
         # object, and no relation a map can check
         text = re.sub(r"\s+(?:to|on) the (?:left|right)(?:\s+(?:hand\s+)?side)?\b(?!\s+(?:of|side)\b)", "", text)
+        # what to do on arrival names no object: "go to the chair by the fridge and stop there";
+        # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
         text = FINAL_COMMAND.sub("", text)
         text = FINAL_COURTESY.sub("", text)
         # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
