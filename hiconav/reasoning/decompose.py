@@ -395,7 +395,7 @@ FILLERS = frozenset([
     "resting", "rests", "there", "it's", "its", "just", "right", "directly", "somewhere", "usually",
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
-    "immediately", "straight", "exactly", "upstairs", "downstairs", "but",
+    "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -601,7 +601,8 @@ class OfflineParser:
                     break
                 if after_comma:  # ", to the right of the fridge": back to the sentence's subject
                     previous = subjects
-                after_comma = bool(np_words) and np_words[-1] == ","
+                # ", near the window" and "and near the window" are said of the same subject
+                after_comma = bool(np_words) and np_words[-1] in (",", "and", "also")
                 # the phrase is parsed up to its negation (``_noun_phrase``); what follows is not
                 negated = any(w in NEGATIONS for w in np_words)
                 if np_words and all(w in PRONOUNS or w == "," for w in np_words):
@@ -705,6 +706,7 @@ class OfflineParser:
         # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
+        text = re.sub(r"\bas well as\b", "and", text)
         # why the speaker asks names no object ("bring me to the tv so I can watch the news")
         text = PURPOSE.sub("", text)
         # a side with nothing it is the side of ("the chair to the left") is the viewer's: no

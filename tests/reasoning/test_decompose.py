@@ -597,3 +597,15 @@ def test_but_and_a_side_of_nothing(parser, text, relations) -> None:
     task = parser.parse(text)
     assert task.targets == ("chair",)
     assert task.relations == relations
+
+
+@pytest.mark.parametrize("text,relations", [
+    # a relation after "and" is said of the same subject, as after a comma; it was said of the
+    # object just named ("the fridge near the window")
+    ("the chair next to the fridge and near the window", (("chair", "next to", "fridge"), ("chair", "near", "window"))),
+    ("the chair near the fridge and also near the window", (("chair", "near", "fridge"), ("chair", "near", "window"))),
+    ("the chair next to the fridge as well as the sink", (("chair", "next to", "fridge"), ("chair", "next to", "sink"))),
+    ("the vase on the table next to the sofa", (("vase", "on", "dining_table"), ("dining_table", "next to", "sofa"))),
+])
+def test_relations_joined_by_and_share_their_subject(parser, text, relations) -> None:
+    assert parser.parse(text).relations == relations
