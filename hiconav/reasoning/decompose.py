@@ -291,6 +291,10 @@ DETERMINERS = frozenset([
     "sort", "type", "very", "really", "quite", "rather",
 ])
 
+# words before "of" that pick from a kind ("a couple of plants"): the kind is the object
+PARTITIVES = frozenset(["either", "neither", "both", "all", "none", "couple", "few", "several", "pair",
+                        "nearest", "closest", "first", "last", "biggest", "largest", "smallest", "any", "one"])
+
 # Leading phrases to strip (longest first), repeated until none applies.
 IMPERATIVES: tuple[str, ...] = tuple(sorted("""
 please|can you|could you|would you|will you|i want you to|i need you to|i'd like you to|
@@ -395,7 +399,7 @@ FILLERS = frozenset([
     "resting", "rests", "there", "it's", "its", "just", "right", "directly", "somewhere", "usually",
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
-    "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also",
+    "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also", "whatever", "whichever",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -707,6 +711,10 @@ class OfflineParser:
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
         text = re.sub(r"\bas well as\b", "and", text)
+        # which one is meant by when it is met, or that any will do ("the first chair you see",
+        # "any laptop will do"): no object, and nothing a map can check
+        text = re.sub(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notice|encounter)(?:\s+first)?"
+                      r"(?=\s*(?:[.!?,;]|$))|\s+(?:will|would) do(?=\s*(?:[.!?,;]|$))", "", text)
         # why the speaker asks names no object ("bring me to the tv so I can watch the news")
         text = PURPOSE.sub("", text)
         # a side with nothing it is the side of ("the chair to the left") is the viewer's: no
@@ -904,8 +912,12 @@ class OfflineParser:
             if after in ROOMS and " ".join(words) not in self.lexicon.phrases:
                 # "the corner of the living room", "the far side of the kitchen": the room
                 return NounPhrase(ROOMS[after], (), " ".join(words), False, room=ROOMS[after])
-            if " ".join(words) not in self.lexicon.phrases and k > 0:
-                words = words[:k]
+            if " ".join(words) not in self.lexicon.phrases:
+                if all(w in PARTITIVES for w in words[:k]) and k + 1 < len(words):
+                    # "one of the chairs", "a couple of plants", "the nearest of the toilets"
+                    words = words[k + 1:]
+                elif k > 0:
+                    words = words[:k]
         if not words or all(w in VOCATIVES for w in words):
             return None  # "Okay, so, the chair ...": words to the robot, no object
         # "the bedroom's tv", "the kitchen's chair": a room in the possessive places the object

@@ -609,3 +609,24 @@ def test_but_and_a_side_of_nothing(parser, text, relations) -> None:
 ])
 def test_relations_joined_by_and_share_their_subject(parser, text, relations) -> None:
     assert parser.parse(text).relations == relations
+
+
+@pytest.mark.parametrize("text,target", [
+    ("find one of the chairs", "chair"),  # a chair qualified "of"
+    ("a couple of plants", "plant"),  # a "couple"
+    ("navigate to either of the armchairs", "armchair"),  # an "either"
+    ("find the nearest of the toilets", "toilet"),  # no object found
+    ("a pair of scissors", "scissors"),
+    ("any laptop will do", "laptop"),  # a "laptop_will_do"
+    ("go to the first chair you see", "chair"),  # a "chair_you_see"
+    ("a bottle of wine", "wine_bottle"),
+])
+def test_one_picked_from_a_kind_is_of_that_kind(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert not task.attributes.get(target)
+
+
+def test_a_question_to_the_robot_is_not_a_chair_it_sees(parser) -> None:
+    # "you find" after "can" asks; only at the end does it say which one is meant
+    assert parser.parse("can you find the plant in the living room?").relations == (("plant", "in", "living_room"),)
