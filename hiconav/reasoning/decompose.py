@@ -292,8 +292,9 @@ DETERMINERS = frozenset([
 ])
 
 # words before "of" that pick from a kind ("a couple of plants"): the kind is the object
+# ("one of the chairs", "any of the beds": "one" and "any" are determiners, gone before "of" is read)
 PARTITIVES = frozenset(["either", "neither", "both", "all", "none", "couple", "few", "several", "pair",
-                        "nearest", "closest", "first", "last", "biggest", "largest", "smallest", "any", "one"])
+                        "nearest", "closest", "first", "last", "biggest", "largest", "smallest"])
 
 # Leading phrases to strip (longest first), repeated until none applies.
 IMPERATIVES: tuple[str, ...] = tuple(sorted("""
@@ -322,6 +323,13 @@ FINAL_COMMAND = re.compile(
     r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?(?:stop|wait|stay|halt|remain)"
     r"(?:\s+(?:there|here|next to it|by it|in front of it|beside it|when you get there|when you arrive|"
     r"once you are there|once you get there))?(?:\s+please)?\s*[.!]*\s*$")
+# which one is meant by when it is met, or that any will do ("the first chair you see", "any
+# laptop will do"): no object, and nothing a map can check; only at a clause's end ("can you find")
+WHICHEVER = re.compile(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notice|encounter)(?:\s+first)?"
+                       r"(?=\s*(?:[.!?,;]|$))|\s+(?:will|would) do(?=\s*(?:[.!?,;]|$))")
+# a side with nothing it is the side of ("the chair to the left") is the viewer's: no object, and
+# no relation a map can check
+VIEWER_SIDE = re.compile(r"\s+(?:to|on) the (?:left|right)(?:\s+(?:hand\s+)?side)?\b(?!\s+(?:of|side)\b)")
 # why the speaker asks, at the end: "bring me to the tv so I can watch the news"
 PURPOSE = re.compile(r",?\s+(?:so that|so|because|since|in order that)\s+(?:i|we|i'd|we'd|i'm|we're)\b[^.!?;]*")
 FINAL_COURTESY = re.compile(
@@ -606,7 +614,8 @@ class OfflineParser:
                 if after_comma:  # ", to the right of the fridge": back to the sentence's subject
                     previous = subjects
                 # ", near the window" and "and near the window" are said of the same subject
-                after_comma = bool(np_words) and np_words[-1] in (",", "and", "also")
+                # ("and also": "also" is a filler, dropped with the others by ``_segments``)
+                after_comma = bool(np_words) and np_words[-1] in (",", "and")
                 # the phrase is parsed up to its negation (``_noun_phrase``); what follows is not
                 negated = any(w in NEGATIONS for w in np_words)
                 if np_words and all(w in PRONOUNS or w == "," for w in np_words):
@@ -711,15 +720,10 @@ class OfflineParser:
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
         text = re.sub(r"\bas well as\b", "and", text)
-        # which one is meant by when it is met, or that any will do ("the first chair you see",
-        # "any laptop will do"): no object, and nothing a map can check
-        text = re.sub(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notice|encounter)(?:\s+first)?"
-                      r"(?=\s*(?:[.!?,;]|$))|\s+(?:will|would) do(?=\s*(?:[.!?,;]|$))", "", text)
+        text = WHICHEVER.sub("", text)
         # why the speaker asks names no object ("bring me to the tv so I can watch the news")
         text = PURPOSE.sub("", text)
-        # a side with nothing it is the side of ("the chair to the left") is the viewer's: no
-        # object, and no relation a map can check
-        text = re.sub(r"\s+(?:to|on) the (?:left|right)(?:\s+(?:hand\s+)?side)?\b(?!\s+(?:of|side)\b)", "", text)
+        text = VIEWER_SIDE.sub("", text)
         # what to do on arrival names no object: "go to the chair by the fridge and stop there";
         # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
         text = FINAL_COMMAND.sub("", text)
