@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import logging
 import re
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Collection, Iterable, Sequence
 from dataclasses import dataclass, field, replace
 
 from hiconav.errors import HiconavError
@@ -193,11 +193,16 @@ ROOMS: dict[str, str] = {
     "lounge area": "living_room", "dining area": "dining_room", "sleeping area": "bedroom",
 }
 
+_ROOM_WORDS = frozenset(w for room in ROOMS for w in room.split())
+
 # words that may stand before a room's name without naming an object: "the second bathroom",
 # "the main bedroom", "the upstairs bathroom" (the room is still a room of that type)
 ROOM_QUALIFIERS = frozenset(["first", "second", "third", "fourth", "other", "main", "spare", "upstairs",
                              "downstairs", "front", "back", "kids", "kid's", "children's", "small", "smaller",
-                             "big", "bigger", "large", "larger", "little", "en", "suite", "ensuite"])
+                             "big", "bigger", "large", "larger", "little", "en", "suite", "ensuite",
+                             "biggest", "largest", "smallest", "tiny", "huge", "nearest", "closest",
+                             "farthest", "furthest", "last", "only", "left", "right", "upper", "lower",
+                             "top", "ground", "middle", "new", "old"])
 
 # Co-occurrence priors (common sense of household layouts): label -> related objects, most
 # telling first. Entries not in the active vocabulary are dropped.
@@ -316,6 +321,11 @@ go look for|go and look for|hey robot|hi robot|hello robot|ok robot|okay robot|h
 by the way|anyway|btw|
 go into|go in|head into|walk into|get into|enter|look in|look inside|search in|check in|check|
 do we have|do you have|have we got|is there|are there|can you see|do you see|what about|how about|
+proceed to|proceed towards|travel to|make your way over to|make your way towards|hurry to|hurry over to|
+run to|rush to|go see|go check|wait by|wait at|wait next to|wait near|wait beside|wait in front of|
+stop next to|stop beside|stop in front of|stop close to|stand near|stand beside|stand in front of|stand at|
+fetch|grab|pick up|get me|bring|go back to|head back to|walk back to|come back to|return to|
+go down to|walk down to|head down to|head up to|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
@@ -330,6 +340,22 @@ WHICHEVER = re.compile(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notic
 # a side with nothing it is the side of ("the chair to the left") is the viewer's: no object, and
 # no relation a map can check
 VIEWER_SIDE = re.compile(r"\s+(?:to|on) the (?:left|right)(?:\s+(?:hand\s+)?side)?\b(?!\s+(?:of|side)\b)")
+# a step of the way that names no object to find ("turn left and find the plant", "go down the
+# hall and find the sink", "go past the sofa and find the tv", "leave the kitchen and ..."):
+# dropped when another clause says what to find
+ROUTE_STEP = re.compile(
+    r"^(?:(?:please|now|first|then|and|so)\s+)*(?:turn|exit|leave|follow|cross|continue|keep going|"
+    r"take the (?:stairs|elevator|lift|hallway|hall|corridor)|go straight|walk straight|go (?:up|down)stairs|"
+    r"(?:go|walk|head|move|drive|continue|keep)\s+(?:down(?!\s+to\b)|along|through|past|across|up(?!\s+to\b)|"
+    r"out of|out|back(?!\s+to\b)|straight|forward|ahead|around|on))\b")
+# who wants what, before what it is: "the chair you want is next to the fridge", "what I'm
+# looking for is the armchair by the lamp", "the object you're looking for is a chair"
+WANTED = re.compile(
+    r"^(?:what|the (?:thing|object|item|one|target))\s+(?:that\s+)?(?:i|you|we)(?:'re|'m|\s+are|\s+am)?\s+"
+    r"(?:want|need|mean|seek|looking for|after|have in mind)(?:\s+to\s+(?:find|reach|see))?\s+is\s+"
+    r"|\s+(?:that\s+|which\s+)?(?:i|you|we)(?:'re|'m|\s+are|\s+am)?\s+"
+    r"(?:want|need|mean|seek|looking for|after|have in mind)(?:\s+to\s+(?:find|reach|see))?\s+is\s+"
+    r"(?:the one\s+)?")
 # why the speaker asks, at the end: "bring me to the tv so I can watch the news"
 PURPOSE = re.compile(r",?\s+(?:so that|so|because|since|in order that)\s+(?:i|we|i'd|we'd|i'm|we're)\b[^.!?;]*")
 FINAL_COURTESY = re.compile(
@@ -344,7 +370,8 @@ SPEAKER_STATE = re.compile(
 ACTIVITY = re.compile(
     r"^(?:i want to|i wanna|i'd like to|i would like to|i'd love to|i would love to|i need to|i have to|"
     r"we want to|we need to|let me|let's|let us|i'm going to|i am going to)\s+"
-    r"(?:sit|lie|lay|sleep|rest|relax|nap|wash|cook|eat|work|study|stand|put|place|leave)"
+    r"(?:sit|lie|lay|sleep|rest|relax|nap|wash|cook|eat|work|study|stand|put|place|leave|"
+    r"(?:take|have|grab) a (?:nap|rest|seat|sit|break|shower|bath|snooze|lie down))"
     r"(?:\s+(?:down|up|back|over))?(?:\s+(?:my|our|the|this|these|it|them)(?:\s+[a-z']+)?)??"
     r"\s+(?:on|in|at|by|near|into|onto|next to|on top of)\s+")
 
@@ -485,6 +512,39 @@ def _spaced(label: str) -> str:
     return label.replace("_", " ").strip().lower()
 
 
+def _slips(a: str, b: str, limit: int) -> int:
+    """Typing slips between ``a`` and ``b`` (optimal string alignment distance: a letter
+    inserted, deleted, replaced, or two neighbours swapped), ``limit + 1`` once past ``limit``."""
+    prev2: list[int] = []
+    prev = list(range(len(b) + 1))
+    for i in range(1, len(a) + 1):
+        cur = [i] + [0] * len(b)
+        for j in range(1, len(b) + 1):
+            cost = a[i - 1] != b[j - 1]
+            cur[j] = min(prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + cost)
+            if i > 1 and j > 1 and a[i - 1] == b[j - 2] and a[i - 2] == b[j - 1]:
+                cur[j] = min(cur[j], prev2[j - 2] + 1)
+        if min(cur) > limit:
+            return limit + 1
+        prev2, prev = prev, cur
+    return prev[-1]
+
+
+def respelt(word: str, words: Collection[str]) -> str:
+    """The one word of ``words`` that ``word`` (five letters or more, not in ``words``, nor its
+    singular) is a typing slip away from ("armchiar", "telivision", "microwve", "bedrom"): one
+    letter added, dropped, changed or two swapped (two slips from eight letters), the first letter
+    kept; ``word`` itself where none or several are nearest."""
+    if len(word) < 5 or word in words or _singular(word) in words:
+        return word
+    limit = 2 if len(word) >= 8 else 1
+    near = [(d, c) for c in words if c[:1] == word[0] and abs(len(c) - len(word)) <= limit
+            and (d := _slips(word, c, limit)) <= limit]
+    best = min((d for d, _ in near), default=None)
+    found = [c for d, c in near if d == best]
+    return found[0] if len(found) == 1 else word
+
+
 @dataclass
 class Lexicon:
     """Phrase -> vocabulary label, built from the vocabulary and the synonym groups."""
@@ -509,6 +569,19 @@ class Lexicon:
             lex.phrases[label] = label
         lex.max_words = max(len(p.split()) for p in lex.phrases) if lex.phrases else 1
         return lex
+
+    def respell(self, phrase: str) -> str:
+        """``phrase`` with each word of five letters or more that the lexicon does not hold
+        replaced by the one lexicon word it is a typing slip away from (``respelt``)."""
+        return " ".join(respelt(w, self.words) for w in phrase.split())
+
+    @property
+    def words(self) -> frozenset[str]:
+        """Every word of the lexicon's phrases."""
+        cached = self.__dict__.get("_words")
+        if cached is None or cached[0] != len(self.phrases):
+            cached = self.__dict__["_words"] = (len(self.phrases), frozenset(w for p in self.phrases for w in p.split()))
+        return cached[1]
 
     def lookup(self, phrase: str) -> str | None:
         phrase = " ".join(phrase.split())
@@ -706,6 +779,11 @@ class OfflineParser:
         best, score = self._most_similar(phrase)
         if best is not None and score >= self.threshold and not _other_kind(phrase, _spaced(best)):
             return best, True
+        spelt = self.lexicon.respell(phrase)
+        if spelt != phrase:
+            hit = self.lexicon.lookup(spelt)
+            if hit is not None:
+                return hit, True
         words = phrase.split()
         if words:
             words[-1] = _singular(words[-1])
@@ -731,8 +809,10 @@ class OfflineParser:
         # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
         text = re.sub(r"\b(?:[a-z]\.){2,}", lambda m: m.group(0).replace(".", "") + " ", text)
         parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"
-                         r"(?:find|look|go|search|locate|navigate|take|walk|head|bring|show|get)\b)"
-                         r"|\s+and\s+(?=(?:find|look for|search for|locate)\b)", text)
+                         r"(?:find|look|go|search|locate|navigate|take|walk|head|bring|show|get|stop|wait|stand|"
+                         r"approach|proceed|travel|move|turn|enter|exit|leave|follow|continue|keep)\b)"
+                         r"|\s+and\s+(?=(?:find|look for|search for|locate|go|walk|head|stop|wait|stand|approach|"
+                         r"proceed|travel|move|navigate|enter|check|make your way|take me|bring me)\b)", text)
         out = []
         for part in parts:
             part = re.sub(r"[^a-z0-9' \-,]", " ", part)
@@ -744,9 +824,11 @@ class OfflineParser:
             # they want to do at an object names it ("I'd love to sit on the sofa")
             part = SPEAKER_STATE.sub("", part).strip()
             part = ACTIVITY.sub("go to ", part)
+            part = " ".join(WANTED.sub(" ", part).split())
             if part:
                 out.append(part)
-        return out
+        kept = [p for p in out if not ROUTE_STEP.match(p)]
+        return kept or out
 
     @staticmethod
     def _strip_imperatives(words: list[str]) -> list[str]:
@@ -931,6 +1013,12 @@ class OfflineParser:
             if len(words) > n and head.endswith("'s") and head[:-2] in ROOMS:
                 np_ = self._noun_phrase(words[n:])
                 return None if np_ is None else replace(np_, in_room=np_.in_room or ROOMS[head[:-2]])
+        # a slip in a room's name ("the bedrom", "the livng room") would make it an object no
+        # detector gives
+        known = self.lexicon.words
+        spelt = [w if w in known else respelt(w, _ROOM_WORDS) for w in words]
+        if spelt != words and any(" ".join(spelt[-n:]) in ROOMS for n in (1, 2, 3)):
+            words = spelt
         text = " ".join(words)
         # Rooms ("the kitchen", "the master bedroom").
         for n in range(min(3, len(words)), 0, -1):

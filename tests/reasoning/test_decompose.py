@@ -630,3 +630,87 @@ def test_one_picked_from_a_kind_is_of_that_kind(parser, text, target) -> None:
 def test_a_question_to_the_robot_is_not_a_chair_it_sees(parser) -> None:
     # "you find" after "can" asks; only at the end does it say which one is meant
     assert parser.parse("can you find the plant in the living room?").relations == (("plant", "in", "living_room"),)
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # a step of the way names no object: it was read as the target ("turn_left", "down_hall", "exit_room")
+    ("Go to the hallway, then turn left and find the plant.", "plant", (("plant", "in", "hallway"),)),
+    ("Turn around and find the bed.", "bed", ()),
+    ("Go down the hall and find the bathroom sink.", "sink", ()),
+    ("Go past the sofa and find the tv.", "tv", ()),  # the sofa was the target
+    ("Exit this room and find the toilet.", "toilet", ()),
+    ("Leave the kitchen and find the sofa in the living room.", "sofa", (("sofa", "in", "living_room"),)),
+    ("go up to the bed", "bed", ()),  # "up to" is the way to it, not a step past it
+    ("go back to the kitchen and find the fridge", "fridge", (("fridge", "in", "kitchen"),)),
+    # what to do there joined by "and": a "stop" next to the fridge, a "tv_stand" in the living room
+    ("Go to the kitchen and stop by the fridge.", "fridge", (("fridge", "in", "kitchen"),)),
+    ("Go into the living room and stand next to the sofa.", "sofa", (("sofa", "in", "living_room"),)),
+    ("Head to the kitchen and stop at the chair next to the fridge.", "chair",
+     (("chair", "next to", "fridge"), ("chair", "in", "kitchen"))),
+    ("Proceed to the kitchen and wait by the fridge.", "fridge", (("fridge", "in", "kitchen"),)),
+    ("Travel to the bedroom and find the dresser.", "dresser", (("dresser", "in", "bedroom"),)),
+    ("Make your way over to the fridge.", "fridge", ()),  # a "make_way" above the fridge
+])
+def test_steps_of_the_way_and_what_to_do_there(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert not task.attributes
+
+
+def test_a_route_alone_still_names_its_object(parser) -> None:
+    # with nothing else to find, the words of the way are all there is
+    assert parser.parse("go past the sofa").targets == ("sofa",)
+
+
+@pytest.mark.parametrize("text", [
+    "The chair I want is the one next to the fridge.",  # a "chair_i_want"
+    "The chair you want is next to the fridge.",
+    "What I'm looking for is the chair next to the fridge.",
+    "The object you're looking for is a chair. It is next to the fridge.",
+    "The one I need is the chair next to the fridge.",
+])
+def test_who_wants_it_names_no_object(parser, text) -> None:
+    task = parser.parse(text)
+    assert task.targets == ("chair",)
+    assert task.relations == (("chair", "next to", "fridge"),)
+    assert not task.attributes
+
+
+@pytest.mark.parametrize("room", ["biggest", "largest", "smallest", "upper", "last"])
+def test_rooms_told_apart_by_size_or_place_are_rooms(parser, room) -> None:
+    # "the biggest bedroom" was a room type no inference gives: the relation was never confirmed
+    assert parser.parse(f"go to the bed in the {room} bedroom").relations == (("bed", "in", "bedroom"),)
+
+
+def test_a_nap_on_the_couch_is_the_couch(parser) -> None:
+    # was a bed on the sofa
+    task = parser.parse("I'd like to take a nap on the couch.")
+    assert task.targets == ("sofa",) and task.relations == ()
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # a typing slip made a label no detector gives ("armchiar", "telivision")
+    ("find the armchiar next to the floor lamp", "armchair", (("armchair", "next to", "floor_lamp"),)),
+    ("find the telivision", "tv", ()),
+    ("go to the microwve", "microwave", ()),
+    ("find the frigde", "fridge", ()),
+    ("find the dreser in the bedrom", "dresser", (("dresser", "in", "bedroom"),)),
+    ("find the plant in the livng room", "plant", (("plant", "in", "living_room"),)),
+])
+def test_typing_slips(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+
+
+def test_respelt_takes_only_a_single_nearest_word() -> None:
+    from hiconav.reasoning.decompose import respelt
+
+    words = {"chair", "chain", "armchair", "television"}
+    assert respelt("armchiar", words) == "armchair"  # two letters swapped
+    assert respelt("chaim", words) == "chaim"  # one slip from both "chair" and "chain"
+    assert respelt("bhair", words) == "bhair"  # the first letter is kept
+    assert respelt("tlvision", words) == "television"  # two slips in a long word
+    assert respelt("char", words) == "char"  # too short to tell a slip from another word
+    assert respelt("chairs", words) == "chairs"  # a plural is no slip
