@@ -8,7 +8,9 @@ next to the fridge."), a relative clause ("the chair that is next to the fridge"
 lead ("I'd like to go to ..."), the relation first ("Next to the fridge, there's a chair. Take me
 to it."), a room in the possessive ("the kitchen's chair"), a dashed afterthought ("the chair
 next to the fridge - go there"), the target called by another name, what to do on arrival
-("... and stop there"), the speaker's reason ("... so I can have a look, thanks"). A parser that
+("... and stop there"), the speaker's reason ("... so I can have a look, thanks"), steps of the
+way first ("Go down the hall, turn left and stop by ..."), who wants it ("The chair I want is the
+one next to the fridge."), a typing slip ("the armhcair ..."). A parser that
 reads only the templates loses the description and stops at the first instance of the category
 it sees.
 
@@ -64,6 +66,18 @@ def other_names(target: str) -> list[str]:
             and not {"on", "for", "of"} & set(n.split())]
 
 
+def slip(name: str) -> str:
+    """``name`` with a typing slip: the two letters after the third of its longest word of
+    five letters or more swapped ("armchiar"); unchanged without such a word."""
+    words = name.split()
+    k = max(range(len(words)), key=lambda i: len(words[i]))
+    w = words[k]
+    if len(w) < 5 or w[3] == w[4]:
+        return name
+    words[k] = w[:3] + w[4] + w[3] + w[5:]
+    return " ".join(words)
+
+
 def forms(instruction: str, target: str) -> dict[str, str]:
     """The people's forms of one template instruction (form name -> text); {} when the template's
     noun phrase cannot be found (the instruction is not a generator template)."""
@@ -83,6 +97,11 @@ def forms(instruction: str, target: str) -> dict[str, str]:
     out["dash"] = f"the {name} {rest} - go there"
     out["arrival"] = f"Could you find the {name} {rest} and stop there"
     out["reason"] = f"bring me to the {name} {rest} so I can have a look, thanks"
+    out["route"] = f"Go down the hall, turn left and stop by the {name} {rest}"
+    out["wanted"] = f"The {name} I want is the one {rest}."
+    slipped = slip(name)
+    if slipped != name:
+        out["slip"] = f"find the {slipped} {rest}"
     others = other_names(target)
     if others:
         other = others[zlib.crc32(instruction.encode()) % len(others)]
