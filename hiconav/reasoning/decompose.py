@@ -152,7 +152,7 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("rug", "carpet", "mat", "doormat", "door mat", "bath mat", "bathmat", "floor mat", "area rug"): ("rug",),
     ("curtains", "curtain", "drapes"): ("curtains",),
     ("cabinet", "cupboard", "kitchen cabinet"): ("cabinet",),
-    ("dog bed", "pet bed", "dog basket", "dog cushion", "pet cushion", "cat bed", "doggy bed", "dog mattress", "pet basket", "cat basket"): ("dog_bed",),
+    ("dog bed", "pet bed", "dog's bed", "cat's bed", "pet's bed", "puppy bed", "dog basket", "dog cushion", "pet cushion", "cat bed", "doggy bed", "dog mattress", "pet basket", "cat basket"): ("dog_bed",),
     ("vacuum cleaner", "vacuum", "hoover"): ("vacuum_cleaner",),
     ("box", "cardboard box", "carton"): ("box",),
     ("statue", "sculpture", "figurine", "statuette", "bust", "figure", "decorative figure", "carving"): ("statue",),
@@ -326,13 +326,20 @@ run to|rush to|go see|go check|wait by|wait at|wait next to|wait near|wait besid
 stop next to|stop beside|stop in front of|stop close to|stand near|stand beside|stand in front of|stand at|
 fetch|grab|pick up|get me|bring|go back to|head back to|walk back to|come back to|return to|
 go down to|walk down to|head down to|head up to|
+take me|bring me|lead me|guide me to|escort me to|lead the way to|show me the way to|show me where|nav to|
+how do i get to|how can i get to|where do you keep|where would i find|where can i find|where do i find|
+i wanna see|i want to see|i'd like to see|i would like to see|i think there's|i think there is|i believe|
+explore until you find|explore until you see|keep exploring until you find|keep exploring until you see|
+search the house for|search the whole house for|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
 FINAL_COMMAND = re.compile(
     r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?(?:stop|wait|stay|halt|remain)"
     r"(?:\s+(?:there|here|next to it|by it|in front of it|beside it|when you get there|when you arrive|"
-    r"once you are there|once you get there))?(?:\s+please)?\s*[.!]*\s*$")
+    r"once you are there|once you get there|"
+    r"(?:when|once|as soon as)\s+(?:you(?:'re|\s+are|\s+get)\s+(?:close to|near|next to|by|at)\s+it|you\s+(?:find|see|reach|spot)\s+it)))?"
+    r"(?:\s+please)?\s*[.!]*\s*$")
 # which one is meant by when it is met, or that any will do ("the first chair you see", "any
 # laptop will do"): no object, and nothing a map can check; only at a clause's end ("can you find")
 WHICHEVER = re.compile(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notice|encounter)(?:\s+first)?"
@@ -340,6 +347,20 @@ WHICHEVER = re.compile(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notic
 # a side with nothing it is the side of ("the chair to the left") is the viewer's: no object, and
 # no relation a map can check
 VIEWER_SIDE = re.compile(r"\s+(?:to|on) the (?:left|right)(?:\s+(?:hand\s+)?side)?\b(?!\s+(?:of|side)\b)")
+# "drive over to the armchair", "roll over to the stool": a motion, not something above the
+# armchair (nor a roll of paper towel)
+MOTION_OVER = re.compile(r"^(?:please\s+)?(?:drive|roll|move|scoot|hop|run|pop|wander|stroll|zip|dash|hurry|rush|"
+                         r"travel|navigate|get|come|go|head|walk|swing|nip|trot)\s+(?:on\s+)?over\s+to\b")
+# "first, ...", "step 2: ...", "finally ...": the order of the steps names no object
+STEP_MARKER = re.compile(r"^(?:step\s+\d+\s*,?\s*|(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|next|quick|quickly|hurry|"
+                         r"hurry up)\s*(?:,\s*|$)|(?:finally|lastly|after that|afterwards)\s*,?\s*)")
+# a hedge about where it is names nothing ("I'm not sure where it is, but ..."); words that only
+# hedge open a clause ("Somewhere in this house there's a teddy bear")
+HEDGE = re.compile(r"^(?:i'm|i am|we're|we are)\s+not\s+sure\s+(?:where|if|whether|which)\b.*$|"
+                   r"^(?:i|we)\s+(?:don't|do not)\s+know\s+(?:where|if|whether|which)\b.*$|^no idea\s+(?:where|if)\b.*$")
+LEADING_HEDGE = re.compile(r"^(?:(?:somewhere|anywhere|maybe|perhaps|probably|possibly|usually)\s+,?\s*)+")
+# "take me to where the bed is", "the place where the tv is": the object
+WHERE_IT_IS = re.compile(r"\b(?:the (?:place|spot|room|area)\s+)?where\s+((?:the|a|an|my|your|our)\s+[a-z' ]+?)\s+(?:is|are)\b")
 # a step of the way that names no object to find ("turn left and find the plant", "go down the
 # hall and find the sink", "go past the sofa and find the tv", "leave the kitchen and ..."):
 # dropped when another clause says what to find
@@ -435,6 +456,7 @@ FILLERS = frozenset([
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
     "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also", "whatever", "whichever",
+    "anywhere",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -808,7 +830,7 @@ class OfflineParser:
         text = FINAL_COURTESY.sub("", text)
         # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
         text = re.sub(r"\b(?:[a-z]\.){2,}", lambda m: m.group(0).replace(".", "") + " ", text)
-        parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"
+        parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+|but\s+|so\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"
                          r"(?:find|look|go|search|locate|navigate|take|walk|head|bring|show|get|stop|wait|stand|"
                          r"approach|proceed|travel|move|turn|enter|exit|leave|follow|continue|keep)\b)"
                          r"|\s+and\s+(?=(?:find|look for|search for|locate|go|walk|head|stop|wait|stand|approach|"
@@ -825,6 +847,9 @@ class OfflineParser:
             part = SPEAKER_STATE.sub("", part).strip()
             part = ACTIVITY.sub("go to ", part)
             part = " ".join(WANTED.sub(" ", part).split())
+            part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", part))
+            part = HEDGE.sub("", MOTION_OVER.sub("go to", part)).strip()
+            part = WHERE_IT_IS.sub(r"\1", part)
             if part:
                 out.append(part)
         kept = [p for p in out if not ROUTE_STEP.match(p)]

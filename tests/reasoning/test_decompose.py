@@ -714,3 +714,35 @@ def test_respelt_takes_only_a_single_nearest_word() -> None:
     assert respelt("tlvision", words) == "television"  # two slips in a long word
     assert respelt("char", words) == "char"  # too short to tell a slip from another word
     assert respelt("chairs", words) == "chairs"  # a plural is no slip
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    ("Is there a TV anywhere in this house?", "tv", ()),  # a "tv_anywhere"
+    ("Quick, find a fire extinguisher!", "fire_extinguisher", ()),  # a "quick"
+    ("First, go to the bedroom. Second, find the dresser.", "dresser", (("dresser", "in", "bedroom"),)),  # a "second"
+    ("Step 1: go to the kitchen. Step 2: find the fridge.", "fridge", (("fridge", "in", "kitchen"),)),
+    ("Drive over to the armchair", "armchair", ()),  # a "drive" above the armchair
+    ("Roll over to the stool", "stool", ()),  # a paper towel roll above the stool
+    ("I'm not sure where it is, but find the safe.", "safe", ()),  # an "i'm" and a safe
+    ("Somewhere in this house there's a teddy bear. Find it.", "teddy_bear", ()),  # no object found
+    ("There might be a vase on the dining table; take me there.", "vase", (("vase", "on", "dining_table"),)),
+    ("Find a bed and stop when you're close to it", "bed", ()),  # a "stop_when_you're" near the bed
+    ("Take me to the place where the bed is", "bed", ()),
+    ("My dog's bed should be in the living room.", "dog_bed", (("dog_bed", "in", "living_room"),)),
+    ("Next to the floor lamp, there's an armchair.", "armchair", (("armchair", "next to", "floor_lamp"),)),
+])
+def test_asides_hedges_and_the_order_of_steps_name_no_object(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert target not in task.related
+
+
+@pytest.mark.parametrize("text", [
+    "How do I get to the bed?", "Guide me to the bed", "Lead the way to the bed", "I wanna see the bed",
+    "Explore until you find a bed", "Search the house for a bed", "I believe the bed is here",
+])
+def test_more_ways_to_ask_leave_no_attributes(parser, text) -> None:
+    # the request's own words were kept as the bed's attributes ("how", "do", "i", "get", "to")
+    task = parser.parse(text)
+    assert task.targets == ("bed",) and not task.attributes
