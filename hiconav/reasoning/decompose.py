@@ -359,6 +359,18 @@ STEP_MARKER = re.compile(r"^(?:step\s+\d+\s*,?\s*|(?:first(?:ly)?|second(?:ly)?|
 HEDGE = re.compile(r"^(?:i'm|i am|we're|we are)\s+not\s+sure\s+(?:where|if|whether|which)\b.*$|"
                    r"^(?:i|we)\s+(?:don't|do not)\s+know\s+(?:where|if|whether|which)\b.*$|^no idea\s+(?:where|if)\b.*$")
 LEADING_HEDGE = re.compile(r"^(?:(?:somewhere|anywhere|maybe|perhaps|probably|possibly|usually)\s+,?\s*)+")
+# how far it stands from another object ("the chair about two meters from the fridge", "a couple
+# of feet from"): near it; a distance no single view measures well enough to tell instances apart
+DISTANCE = re.compile(r"\s+(?:about|around|roughly|approximately|some|maybe|only|just)?\s*"
+                      r"(?:a|an|one|two|three|four|five|a few|a couple of|a couple|several|half a|\d+(?:\.\d+)?)\s*"
+                      r"(?:meters?|metres?|m|feet|foot|ft|steps?|paces?|yards?)\s+(?:away\s+)?(?:from|of)\s+")
+# "the bed whose headboard is under the painting": said of the bed
+WHOSE_PART = re.compile(r"\s+whose\s+[a-z']+(?:\s+[a-z']+)?\s+(?:is|are|sits|stands|faces)\s+")
+# "the laptop that someone left on the bed", "the mug that was left on the counter": where it
+# was put is where it is
+PUT_THERE = re.compile(r"\s+(?:that|which)?\s*(?:someone|somebody|i|we|you|they|he|she|was|were|got|has been|"
+                       r"had been|is)?\s*(?:left|put|placed|dropped|set down|forgot|forgotten|kept|stored)"
+                       r"(?=\s+(?:on|in|under|by|next|near|beside|at|inside|atop|behind|underneath|beneath)\b)")
 # "take me to where the bed is", "the place where the tv is": the object
 WHERE_IT_IS = re.compile(r"\b(?:the (?:place|spot|room|area)\s+)?where\s+((?:the|a|an|my|your|our)\s+[a-z' ]+?)\s+(?:is|are)\b")
 # a step of the way that names no object to find ("turn left and find the plant", "go down the
@@ -432,6 +444,20 @@ RELATIONS: dict[str, str] = {
     # "the desk that has a lamp on it": what it carries is near it (its own relation, "on it",
     # follows and is parsed on the carried object)
     "has": "with", "have": "with", "having": "with", "holding": "with", "holds": "with",
+    # which way it is turned ("the sofa that faces the tv" made the tv the target)
+    "faces": "facing", "face": "facing", "facing towards": "facing", "facing toward": "facing",
+    "pointed at": "facing", "pointing at": "facing", "pointing towards": "facing", "turned towards": "facing",
+    "turned toward": "facing", "oriented towards": "facing", "angled towards": "facing",
+    "across the room from": "opposite", "on the other side of the room from": "opposite",
+    "diagonally opposite": "near", "diagonally across from": "near", "diagonally from": "near",
+    "diagonal to": "near", "diagonal from": "near", "kitty corner from": "near", "kitty corner to": "near",
+    "catty corner from": "near", "catty corner to": "near",
+    "within arm's reach of": "near", "within easy reach of": "near", "flanked by": "next to",
+    "at the foot of": "next to", "at the head of": "next to", "on the same wall as": "near",
+    "same wall as": "near", "in the same room as": "near",
+    "tucked in at": "next to", "tucked in to": "next to", "tucked in under": "under", "pushed in at": "next to",
+    "pushed in under": "under", "sandwiched between": "between", "squeezed between": "between",
+    "wedged between": "between", "nestled between": "between",
 }
 _RELATION_KEYS = sorted(RELATIONS, key=lambda p: -len(p.split()))
 
@@ -456,7 +482,7 @@ FILLERS = frozenset([
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
     "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also", "whatever", "whichever",
-    "anywhere",
+    "anywhere", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -828,6 +854,8 @@ class OfflineParser:
         # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
         text = FINAL_COMMAND.sub("", text)
         text = FINAL_COURTESY.sub("", text)
+        # a decimal point ends no sentence ("1.5 m from the fridge")
+        text = re.sub(r"(\d)\.(\d)", r"\1\2", text)
         # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
         text = re.sub(r"\b(?:[a-z]\.){2,}", lambda m: m.group(0).replace(".", "") + " ", text)
         parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+|but\s+|so\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"
@@ -850,6 +878,8 @@ class OfflineParser:
             part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", part))
             part = HEDGE.sub("", MOTION_OVER.sub("go to", part)).strip()
             part = WHERE_IT_IS.sub(r"\1", part)
+            part = PUT_THERE.sub(" ", WHOSE_PART.sub(" ", DISTANCE.sub(" near ", part)))
+            part = " ".join(re.sub(r"\brather than\b", "not", part).split())
             if part:
                 out.append(part)
         kept = [p for p in out if not ROUTE_STEP.match(p)]

@@ -746,3 +746,33 @@ def test_more_ways_to_ask_leave_no_attributes(parser, text) -> None:
     # the request's own words were kept as the bed's attributes ("how", "do", "i", "get", "to")
     task = parser.parse(text)
     assert task.targets == ("bed",) and not task.attributes
+
+
+@pytest.mark.parametrize("text,relations", [
+    # a distance was read into the target ("chair_about_two_meter", "chair_couple")
+    ("Go to the chair about two meters from the fridge.", (("chair", "near", "fridge"),)),
+    ("Go to the chair a couple of feet from the fridge.", (("chair", "near", "fridge"),)),
+    ("Go to the chair 1.5 m away from the fridge.", (("chair", "near", "fridge"),)),
+    ("Find the chair that is within arm's reach of the fridge.", (("chair", "near", "fridge"),)),
+    ("Find the chair sitting across the room from the fridge.", (("chair", "opposite", "fridge"),)),
+    ("Find the chair that's kitty-corner from the fridge.", (("chair", "near", "fridge"),)),
+    ("Go to the chair positioned diagonally from the fridge.", (("chair", "near", "fridge"),)),
+    ("Find the chair that faces the fridge.", (("chair", "facing", "fridge"),)),  # the fridge was the target
+    ("Find the chair that someone left by the fridge.", (("chair", "next to", "fridge"),)),  # a "chair_someone_left"
+    ("Find the chair that was left next to the fridge.", (("chair", "next to", "fridge"),)),
+    ("Find the chair whose back is against the fridge.", (("chair", "against", "fridge"),)),  # a "chair_whose_back"
+    ("Find the chair at the head of the dining table.", (("chair", "next to", "dining_table"),)),
+    ("Find the chair tucked in at the dining table.", (("chair", "next to", "dining_table"),)),
+    ("Find the chair sandwiched between the fridge and the sink.", (("chair", "between", "fridge"), ("chair", "between", "sink"))),
+    ("Find the chair flanked by two fridges.", (("chair", "next to", "fridge"),)),
+    ("Find the chair on the same wall as the fridge.", (("chair", "near", "fridge"),)),  # a chair on the fridge
+    ("Find the chair in the kitchen rather than the one in the dining room.", (("chair", "in", "kitchen"),)),
+])
+def test_distances_ways_it_is_turned_and_how_it_was_put(parser, text, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == ("chair",)
+    assert task.relations == relations
+
+
+def test_left_as_a_side_is_not_put_there(parser) -> None:
+    assert parser.parse("the chair on the left of the fridge").relations == (("chair", "left of", "fridge"),)
