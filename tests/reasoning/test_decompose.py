@@ -776,3 +776,22 @@ def test_distances_ways_it_is_turned_and_how_it_was_put(parser, text, relations)
 
 def test_left_as_a_side_is_not_put_there(parser) -> None:
     assert parser.parse("the chair on the left of the fridge").relations == (("chair", "left of", "fridge"),)
+
+
+@pytest.mark.parametrize("word", ["cooler", "lounger", "candle"])
+def test_words_of_their_own_are_no_slips(parser, word) -> None:
+    # "cooler" is one letter from "cooker" (an oven), "lounger" from the room "lounge": English
+    # words, or words made from a lexicon word, are read as said
+    assert parser.parse(f"find the {word}").targets == (word,)
+
+
+@pytest.mark.parametrize("text,target,attributes", [
+    ("find the upholstered chair", "armchair", {"armchair": ("upholstered",)}),  # a chair
+    ("find the small lamp", "desk_lamp", {"desk_lamp": ("small",)}),  # a small floor lamp
+    ("go to the desk light", "desk_lamp", {}),  # "light" names it, and is no attribute of it
+    ("find the wooden chair", "chair", {"chair": ("wooden",)}),
+])
+def test_names_with_an_attribute_word_in_them(parser, text, target, attributes) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.attributes == attributes
