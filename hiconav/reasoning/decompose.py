@@ -332,7 +332,7 @@ take me|bring me|lead me|guide me to|escort me to|lead the way to|show me the wa
 how do i get to|how can i get to|where do you keep|where would i find|where can i find|where do i find|
 i wanna see|i want to see|i'd like to see|i would like to see|i think there's|i think there is|i believe|
 explore until you find|explore until you see|keep exploring until you find|keep exploring until you see|
-search the house for|search the whole house for|
+search the house for|search the whole house for|going to|heading to|walking to|can u|could u|would u|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
@@ -342,6 +342,27 @@ FINAL_COMMAND = re.compile(
     r"once you are there|once you get there|"
     r"(?:when|once|as soon as)\s+(?:you(?:'re|\s+are|\s+get)\s+(?:close to|near|next to|by|at)\s+it|you\s+(?:find|see|reach|spot)\s+it)))?"
     r"(?:\s+please)?\s*[.!]*\s*$")
+# what to report or do after arriving: "find the bed and let me know", "... and come back"
+AFTERWARDS = re.compile(
+    r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?(?:let me know|tell me|report back|report|"
+    r"come back|return|come back to me|return to me|wait for me|call me|ping me|notify me)"
+    r"(?:\s+(?:when|once|if)\s+[a-z' ]+)?(?:\s+please)?\s*[.!]*\s*$")
+# words that lead in a request and name no object: "if you don't mind, ...", "when you get a
+# chance, ...", "your task: ...", "the robot should ...", "I was wondering if you could ..."
+LEAD_IN = re.compile(
+    r"^(?:(?:if you (?:don't|do not) mind|when you (?:get|have) (?:a|the) (?:chance|moment|minute|second)|"
+    r"whenever you can|if you can|if possible|when you can|at your convenience|when you're ready|"
+    r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh)\s*(?:,\s*|$)|"
+    r"(?:so\s+|um\s+|okay\s+|ok\s+)*(?:i was wondering if you could|i'd appreciate it if you could|"
+    r"i would appreciate it if you could|would you mind|would you be so kind as to|do you know where|"
+    r"can you tell me where|could you tell me where|let me know when you reach|let me know when you find|"
+    r"it's time to|time to|basically|(?:the )?robot (?:should|must|needs to|has to|will|can)|"
+    r"you need to|you have to|you must|you should|you are looking for|you're looking for|we are looking for|"
+    r"we're looking for|(?:your |the )?(?:task|mission|instruction|objective|job)(?: is)?(?:\s+to)?"
+    r"(?=\s+(?:find|go|locate|reach|navigate|search|look|get|move|walk|head|take|bring|approach)\b))\s+)+")
+# "navigate the robot to the bed", "send the robot to ...", "navigate yourself to ...": go to
+ROBOT_OBJECT = re.compile(r"\b(?:navigate|move|send|drive|take|bring|get|steer|guide|direct|walk)\s+"
+                          r"(?:the\s+|this\s+|our\s+|my\s+)?(?:robot|yourself|itself)\s+(?:over\s+)?to\b")
 # which one is meant by when it is met, or that any will do ("the first chair you see", "any
 # laptop will do"): no object, and nothing a map can check; only at a clause's end ("can you find")
 WHICHEVER = re.compile(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notice|encounter)(?:\s+first)?"
@@ -360,7 +381,7 @@ STEP_MARKER = re.compile(r"^(?:step\s+\d+\s*,?\s*|(?:first(?:ly)?|second(?:ly)?|
 # hedge open a clause ("Somewhere in this house there's a teddy bear")
 HEDGE = re.compile(r"^(?:i'm|i am|we're|we are)\s+not\s+sure\s+(?:where|if|whether|which)\b.*$|"
                    r"^(?:i|we)\s+(?:don't|do not)\s+know\s+(?:where|if|whether|which)\b.*$|^no idea\s+(?:where|if)\b.*$")
-LEADING_HEDGE = re.compile(r"^(?:(?:somewhere|anywhere|maybe|perhaps|probably|possibly|usually)\s+,?\s*)+")
+LEADING_HEDGE = re.compile(r"^(?:(?:somewhere|anywhere|maybe|perhaps|probably|possibly|usually|just|simply)\s+,?\s*)+")
 # how far it stands from another object ("the chair about two meters from the fridge", "a couple
 # of feet from"): near it; a distance no single view measures well enough to tell instances apart
 DISTANCE = re.compile(r"\s+(?:about|around|roughly|approximately|some|maybe|only|just)?\s*"
@@ -484,7 +505,7 @@ FILLERS = frozenset([
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
     "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also", "whatever", "whichever",
-    "anywhere", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
+    "anywhere", "together", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -876,7 +897,8 @@ class OfflineParser:
         text = VIEWER_SIDE.sub("", text)
         # what to do on arrival names no object: "go to the chair by the fridge and stop there";
         # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
-        text = FINAL_COMMAND.sub("", text)
+        text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", text))
+        text = ROBOT_OBJECT.sub("go to", text)
         text = FINAL_COURTESY.sub("", text)
         # a decimal point ends no sentence ("1.5 m from the fridge")
         text = re.sub(r"(\d)\.(\d)", r"\1\2", text)
@@ -899,7 +921,7 @@ class OfflineParser:
             part = SPEAKER_STATE.sub("", part).strip()
             part = ACTIVITY.sub("go to ", part)
             part = " ".join(WANTED.sub(" ", part).split())
-            part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", part))
+            part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", LEAD_IN.sub("", part)))
             part = HEDGE.sub("", MOTION_OVER.sub("go to", part)).strip()
             part = WHERE_IT_IS.sub(r"\1", part)
             part = PUT_THERE.sub(" ", WHOSE_PART.sub(" ", DISTANCE.sub(" near ", part)))

@@ -795,3 +795,27 @@ def test_names_with_an_attribute_word_in_them(parser, text, target, attributes) 
     task = parser.parse(text)
     assert task.targets == (target,)
     assert task.attributes == attributes
+
+
+@pytest.mark.parametrize("text", [
+    "If you don't mind, find the bed.",  # an "if_you_don't_mind"
+    "When you get a chance, go to the bed.",  # a "when_you_get_chance"
+    "Find the bed and let me know",  # a second target "let_me_know"
+    "Find the bed and tell me when you're there",
+    "Find the bed and come back",
+    "Look, just find the bed.",  # a "look" and the bed
+    "Let's find the bed together.",  # a "bed_together"
+    "Your task: locate the bed.", "Your task is to find the bed", "Mission: reach the bed.",
+    "Please navigate the robot to the bed.", "Send the robot to the bed.", "Navigate yourself to the bed",
+    "The robot should go to the bed.", "So, um, I was wondering if you could find the bed",
+    "Would you be so kind as to find the bed?", "Would you mind going to the bed?",
+    "Can you tell me where the bed is?", "You are looking for a bed.", "can u find the bed plz",
+])
+def test_lead_ins_and_what_comes_after_name_no_object(parser, text) -> None:
+    task = parser.parse(text)
+    assert task.targets == ("bed",)
+    assert not task.attributes and not task.relations
+
+
+def test_a_task_lamp_is_no_task(parser) -> None:
+    assert parser.parse("task lamp, please").targets == ("desk_lamp",)
