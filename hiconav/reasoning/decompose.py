@@ -332,7 +332,7 @@ take me|bring me|lead me|guide me to|escort me to|lead the way to|show me the wa
 how do i get to|how can i get to|where do you keep|where would i find|where can i find|where do i find|
 i wanna see|i want to see|i'd like to see|i would like to see|i think there's|i think there is|i believe|
 explore until you find|explore until you see|keep exploring until you find|keep exploring until you see|
-search the house for|search the whole house for|going to|heading to|walking to|can u|could u|would u|
+search the house for|search the whole house for|going to|heading to|walking to|can u|could u|would u|you'll find|you will find|you can find|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
@@ -394,6 +394,34 @@ WHOSE_PART = re.compile(r"\s+whose\s+[a-z']+(?:\s+[a-z']+)?\s+(?:is|are|sits|sta
 PUT_THERE = re.compile(r"\s+(?:that|which)?\s*(?:someone|somebody|i|we|you|they|he|she|was|were|got|has been|"
                        r"had been|is)?\s*(?:left|put|placed|dropped|set down|forgot|forgotten|kept|stored)"
                        r"(?=\s+(?:on|in|under|by|next|near|beside|at|inside|atop|behind|underneath|beneath)\b)")
+# relations that hold the other way round, and what they then read
+INVERSE = {"next to": "next to", "near": "near", "facing": "facing", "opposite": "opposite", "with": "near",
+           "against": "against", "on": "under", "under": "on", "above": "below", "below": "above"}
+# the kind named first, then which one: "among the chairs, find the one next to the fridge",
+# "not the chair in the dining room, the one in the kitchen": "the one" is of that kind
+KIND_FIRST = re.compile(r"^(?:among|amongst|of|out of|from)\s+(?:all\s+)?(?:the|these|those)\s+([a-z' ]+?)\s*,\s*")
+NEGATED_FIRST = re.compile(r"^not\s+(?:the|a|an|that|this)\s+([a-z' ]+?)\s+(?:in|on|at|by|next to|near|beside|under|"
+                           r"above|behind|close to)\b[^,;.]*[,;.]\s*(?:but\s+|rather\s+)?(?=the one\b)")
+# "make sure it's the one by the fridge", "specifically the one ...", "you know, the one ...":
+# words that insist name no object
+INSIST = re.compile(r"\b(?:make sure|be sure|ensure)\s+(?:that\s+)?(?=it|it's|its)|\b(?:specifically|namely|"
+                    r"particularly|especially|precisely|in particular|i\.e\.?|ie|you know)\b\s*,?")
+# what the speaker does with it: "the chair that I usually sit on", "the bed I sleep in": no
+# relation a view can check
+HABIT = re.compile(r"\s+(?:that\s+|which\s+)?(?:i|we|you|he|she|they|mom|dad)\s+(?:usually\s+|always\s+|often\s+|"
+                   r"normally\s+|sometimes\s+)?(?:sit on|sit in|sleep on|sleep in|use|like|love|prefer|work at|"
+                   r"eat at|read in|read on|watch|lie on|rest on|relax on|relax in)\b")
+# "far from the window" says where it is not; "closer to the fridge than to the table": near
+# the first
+FAR_FROM = re.compile(r"(?<!not)\s*,?\s+(?:but\s+|and\s+)?far\s+(?:away\s+)?from\s+(?:the|a|an)\s+[a-z' ]+?"
+                      r"(?=\s*(?:[,.;!?]|$))")
+CLOSER_THAN = re.compile(r"\b(?:closer|nearer)\s+to\s+((?:the|a|an)\s+[a-z' ]+?)\s+than\s+(?:to\s+)?(?:the|a|an)\s+[a-z' ]+?"
+                         r"(?=\s*(?:[,.;!?]|$))")
+# "a fridge on its left": a side of the object sought, already said by what it has
+ITS_SIDE = re.compile(r"\s+(?:on|to)\s+(?:its|his|her|their)\s+(?:left|right)(?:\s+(?:hand\s+)?side)?\b")
+# "..., that's what I want you to find": the speaker pointing back names nothing new
+THATS_IT = re.compile(r",?\s*that's\s+(?:what|the one|it)(?:\s+(?:i|we)\s+(?:want|need|mean|am looking for|'m looking for)"
+                      r"(?:\s+you\s+to\s+(?:find|reach|go to|locate))?)?\s*[.!]*\s*$")
 # "take me to where the bed is", "the place where the tv is": the object
 WHERE_IT_IS = re.compile(r"\b(?:the (?:place|spot|room|area)\s+)?where\s+((?:the|a|an|my|your|our)\s+[a-z' ]+?)\s+(?:is|are)\b")
 # a step of the way that names no object to find ("turn left and find the plant", "go down the
@@ -731,6 +759,8 @@ class OfflineParser:
 
         for si, sentence in enumerate(sentences):
             words = sentence.split()
+            if targets and self._promote(words, targets, related, relations):
+                continue
             refers_to_target = bool(targets) and self._refers_to_target(words, targets)
             words = self._strip_imperatives(words)
             if not words or all(w in VOCATIVES for w in words):
@@ -752,6 +782,8 @@ class OfflineParser:
             else:
                 subjects = self._noun_phrases(head_words)
                 if not subjects:
+                    if any(w in NEGATIONS for w in head_words):
+                        continue  # "Not the one by the table.": what it is not
                     # "In the kitchen, find the chair ...": a room ahead of the object it holds;
                     # "Beside the bed, find the dresser": an object ahead of it, said of the target
                     for relation, np_words in rest:
@@ -897,7 +929,13 @@ class OfflineParser:
         text = VIEWER_SIDE.sub("", text)
         # what to do on arrival names no object: "go to the chair by the fridge and stop there";
         # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
-        text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", text))
+        text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", THATS_IT.sub("", text)))
+        text = INSIST.sub(" ", text)
+        text = CLOSER_THAN.sub(r"near \1", FAR_FROM.sub("", ITS_SIDE.sub("", HABIT.sub(" ", text))))
+        for first in (KIND_FIRST, NEGATED_FIRST):
+            m = first.match(text)
+            if m and re.search(r"\bthe one\b", text[m.end():]):
+                text = re.sub(r"\bthe one\b", "the " + m.group(1), text[m.end():], count=1)
         text = ROBOT_OBJECT.sub("go to", text)
         text = FINAL_COURTESY.sub("", text)
         # a decimal point ends no sentence ("1.5 m from the fridge")
@@ -1022,6 +1060,34 @@ class OfflineParser:
         if not self._noun_phrases(first) or not self._noun_phrases([w for w in second if w not in PRONOUNS]):
             return words
         return first + ["with"] + second + rel + ["it"]
+
+    def _promote(self, words: list[str], targets: list[NounPhrase], related: list[NounPhrase],
+                 relations: list[tuple[str, str, str]]) -> bool:
+        """"The fridge has a chair next to it. Go to that chair.", "I left my keys near the small
+        table, go to that table": a request for "that" / "this" / "the same" object named
+        earlier, not as the target, makes it the target (the earlier target becomes related;
+        the relations said stay as they were). True when it did."""
+        for i, w in enumerate(words):
+            if w not in ("that", "this", "same"):
+                continue
+            if self._strip_imperatives(words[:i]):
+                return False  # other words before it: not a request for it
+            named = self._noun_phrases([x for x in words[i + 1:] if x not in FILLERS])
+            if len(named) != 1 or named[0].room is not None or named[0].label == targets[0].label:
+                return False
+            earlier = next((p for p in related if p.label == named[0].label), None)
+            if earlier is None:
+                return False
+            related.remove(earlier)
+            related.append(targets[0])
+            old, targets[0] = targets[0].label, earlier
+            # what was said of the old target with the new one holds the other way round too
+            # ("the sofa faces a tv": the tv faces the sofa; "the fridge has a chair": near it)
+            for a, r, b in list(relations):
+                if a == old and b == earlier.label and r in INVERSE:
+                    relations.append((b, INVERSE[r], a))
+            return True
+        return False
 
     def _refers_to_target(self, words: list[str], targets: list[NounPhrase]) -> bool:
         if words and words[0] in ("it", "it's", "its", "this", "which"):

@@ -819,3 +819,37 @@ def test_lead_ins_and_what_comes_after_name_no_object(parser, text) -> None:
 
 def test_a_task_lamp_is_no_task(parser) -> None:
     assert parser.parse("task lamp, please").targets == ("desk_lamp",)
+
+
+@pytest.mark.parametrize("text,relations", [
+    ("Among the chairs, find the one next to the fridge.", (("chair", "next to", "fridge"),)),  # no object found
+    ("Of all the chairs, go to the one by the fridge.", (("chair", "next to", "fridge"),)),
+    ("Not the chair in the dining room, the one in the kitchen.", (("chair", "in", "kitchen"),)),  # no object found
+    ("The chair by the fridge. Not the one by the table.", (("chair", "next to", "fridge"),)),  # "by the table" kept
+    ("Find a chair. Make sure it's the one by the fridge.", (("chair", "next to", "fridge"),)),  # a "make_sure"
+    ("Find the chair, specifically the one next to the fridge.", (("chair", "next to", "fridge"),)),  # 2 targets
+    ("Find the chair - you know, the one next to the fridge.", (("chair", "next to", "fridge"),)),
+    ("Find the chair that I usually sit on, next to the fridge.", (("chair", "next to", "fridge"),)),  # a "chair_i"
+    ("Find the chair near the fridge but far from the window.", (("chair", "near", "fridge"),)),  # fridge near window
+    ("Find the chair that is closer to the fridge than to the table.", (("chair", "near", "fridge"),)),  # near the table
+    ("Find a chair that has a fridge on its left and a sink on its right.",
+     (("chair", "with", "fridge"), ("chair", "with", "sink"))),  # a fridge on the sink
+    ("The chair by the fridge, that's what I want you to find.", (("chair", "next to", "fridge"),)),
+    ("The fridge has a chair next to it. Go to that chair.",  # the fridge was the target
+     (("fridge", "with", "chair"), ("chair", "next to", "fridge"), ("chair", "near", "fridge"))),
+])
+def test_which_one_said_around_the_kind(parser, text, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == ("chair",)
+    assert task.relations == relations
+    assert not task.attributes
+
+
+def test_that_object_named_earlier_becomes_the_target(parser) -> None:
+    task = parser.parse("I left my keys near the small table by the sofa, go to that table")
+    assert task.targets == ("dining_table",)
+    assert ("dining_table", "next to", "sofa") in task.relations
+    task = parser.parse("The sofa faces a tv. Take me to the same tv.")
+    assert task.targets == ("tv",) and ("tv", "facing", "sofa") in task.relations
+    # the target itself called "that chair" changes nothing
+    assert parser.parse("Find the chair. That chair is next to the fridge.").relations == (("chair", "next to", "fridge"),)
