@@ -193,7 +193,18 @@ ROOMS: dict[str, str] = {
     # "the fridge in the kitchen area": an area named after a room is that room
     "kitchen area": "kitchen", "living area": "living_room", "sitting area": "living_room",
     "lounge area": "living_room", "dining area": "dining_room", "sleeping area": "bedroom",
+    "cooking area": "kitchen", "galley": "kitchen", "great room": "living_room", "lounge room": "living_room",
+    "rumpus room": "living_room", "playroom": "living_room", "play room": "living_room", "media room": "living_room",
+    "reception room": "living_room", "drawing room": "living_room", "parlor": "living_room",
+    "parlour": "living_room", "bedchamber": "bedroom", "sleeping quarters": "bedroom", "box room": "bedroom",
+    "master suite": "bedroom", "primary suite": "bedroom", "guest suite": "bedroom", "home office": "office",
+    "landing": "hallway", "mudroom": "hallway", "mud room": "hallway", "utility": "laundry_room",
 }
+# fixtures whose name also names the room they stand in: "the plant in the loo" is in the
+# bathroom, not inside a toilet
+ROOM_FIXTURES = {"toilet": "bathroom"}
+# rooms one is "on" rather than "in"
+ON_ROOMS = frozenset(["landing"])
 
 _ROOM_WORDS = frozenset(w for room in ROOMS for w in room.split())
 
@@ -823,8 +834,12 @@ class OfflineParser:
                     continue
                 phrases = self._noun_phrases(np_words)
                 for p in phrases:
+                    if relation == "in" and not p.room and p.label in ROOM_FIXTURES:
+                        p = replace(p, room=ROOM_FIXTURES[p.label])
                     # "the painting on the wall of the bedroom": on a part of a room is in it
                     rel = "in" if p.room and p.text.split()[0] in PLACE_NOUNS and " of " in p.text else relation
+                    if p.room and rel == "on" and p.text.split()[-1] in ON_ROOMS:
+                        rel = "in"  # "on the landing"
                     if p.room and rel not in CONTAINMENT:
                         # "the toilet in the bathroom next to the bedroom": where a room lies is
                         # not a relation of the object, and names no room it is in

@@ -853,3 +853,18 @@ def test_that_object_named_earlier_becomes_the_target(parser) -> None:
     assert task.targets == ("tv",) and ("tv", "facing", "sofa") in task.relations
     # the target itself called "that chair" changes nothing
     assert parser.parse("Find the chair. That chair is next to the fridge.").relations == (("chair", "next to", "fridge"),)
+
+
+@pytest.mark.parametrize("where,room", [
+    ("in the loo", "bathroom"), ("in the wc", "bathroom"), ("in the toilet", "bathroom"),  # inside a toilet
+    ("in the cooking area", "kitchen"), ("in the galley", "kitchen"), ("in the great room", "living_room"),
+    ("in the lounge room", "living_room"), ("in the drawing room", "living_room"), ("in the parlour", "living_room"),
+    ("in the master suite", "bedroom"), ("in the box room", "bedroom"), ("in the home office", "office"),  # a desk
+    ("on the landing", "hallway"),
+])
+def test_more_names_of_rooms(parser, where, room) -> None:
+    assert parser.parse(f"find the plant {where}").relations == (("plant", "in", room),)
+
+
+def test_the_loo_alone_is_the_toilet(parser) -> None:
+    assert parser.parse("take me to the loo").targets == ("toilet",)
