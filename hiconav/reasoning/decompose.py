@@ -103,7 +103,8 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("remote control", "remote", "tv remote", "clicker"): ("remote_control",),
     ("painting", "picture", "artwork", "poster", "framed picture", "portrait", "canvas", "photo", "photograph",
      "framed photo", "picture frame", "photo frame", "wall art", "print"): ("painting",),
-    ("counter top", "countertop", "counter", "kitchen counter", "worktop", "kitchen island",
+    ("counter top", "countertop", "counter", "kitchen counter", "worktop", "kitchen island", "breakfast bar",
+     "kitchen bar", "island",
      "island"): ("counter_top", "counter"),
     ("floor lamp", "standing lamp", "lamp", "light", "floor light", "standard lamp", "torchiere", "uplighter", "uplight", "arc lamp"): ("floor_lamp", "lamp"),
     ("desk lamp", "small lamp", "table lamp", "reading lamp", "bedside lamp", "desk light", "study lamp", "bedside light",
@@ -433,6 +434,13 @@ ITS_SIDE = re.compile(r"\s+(?:on|to)\s+(?:its|his|her|their)\s+(?:left|right)(?:
 # "..., that's what I want you to find": the speaker pointing back names nothing new
 THATS_IT = re.compile(r",?\s*that's\s+(?:what|the one|it)(?:\s+(?:i|we)\s+(?:want|need|mean|am looking for|'m looking for)"
                       r"(?:\s+you\s+to\s+(?:find|reach|go to|locate))?)?\s*[.!]*\s*$")
+# "the tv attached to the wall opposite the bed": the wall is no object, what follows is said of
+# the tv; "all the way at the end of the hallway": at its end
+ON_THE_WALL = re.compile(r"\s+(?:attached|fixed|fastened|mounted|screwed|bolted|pinned|stuck)\s+(?:to|on|onto)\s+"
+                         r"the\s+wall\b|\s+all the way(?=\s)")
+# "to the left when you enter the kitchen": the room entered is the one it is in
+ON_ENTERING = re.compile(r"\s+(?:as|when|once|after)\s+you\s+(?:enter|come in(?:to)?|walk in(?:to)?|go in(?:to)?|step into|"
+                         r"get into)\s+((?:the|a)\s+[a-z' ]+?)(?=\s*(?:[,.;!?]|$))")
 # "take me to where the bed is", "the place where the tv is": the object
 WHERE_IT_IS = re.compile(r"\b(?:the (?:place|spot|room|area)\s+)?where\s+((?:the|a|an|my|your|our)\s+[a-z' ]+?)\s+(?:is|are)\b")
 # a step of the way that names no object to find ("turn left and find the plant", "go down the
@@ -506,6 +514,9 @@ RELATIONS: dict[str, str] = {
     # "the desk that has a lamp on it": what it carries is near it (its own relation, "on it",
     # follows and is parsed on the carried object)
     "has": "with", "have": "with", "having": "with", "holding": "with", "holds": "with",
+    # just beyond another object ("the plant just past the sofa" made the sofa the target)
+    "past": "near", "beyond": "near", "just past": "near", "just beyond": "near",
+    "overlooking": "facing", "looking out of": "facing", "looking out": "facing", "looking onto": "facing",
     # which way it is turned ("the sofa that faces the tv" made the tv the target)
     "faces": "facing", "face": "facing", "facing towards": "facing", "facing toward": "facing",
     "pointed at": "facing", "pointing at": "facing", "pointing towards": "facing", "turned towards": "facing",
@@ -837,7 +848,9 @@ class OfflineParser:
                     if relation == "in" and not p.room and p.label in ROOM_FIXTURES:
                         p = replace(p, room=ROOM_FIXTURES[p.label])
                     # "the painting on the wall of the bedroom": on a part of a room is in it
-                    rel = "in" if p.room and p.text.split()[0] in PLACE_NOUNS and " of " in p.text else relation
+                    # ("at the far end of the kitchen": a place word among the words before "of")
+                    place = p.text.split(" of ")[0].split()
+                    rel = "in" if p.room and " of " in p.text and PLACE_NOUNS.intersection(place) else relation
                     if p.room and rel == "on" and p.text.split()[-1] in ON_ROOMS:
                         rel = "in"  # "on the landing"
                     if p.room and rel not in CONTAINMENT:
@@ -870,6 +883,9 @@ class OfflineParser:
                     attributes.setdefault(p.label, [])
                     attributes[p.label] += [a for a in p.attributes if a not in attributes[p.label]]
 
+        if not targets and ahead:
+            # only objects after a relation ("go past the sofa", "next to the fridge"): where to go
+            targets.append(ahead.pop(0)[1])
         if targets:
             for relation, p in ahead:
                 if p.label != targets[0].label and (targets[0].label, relation, p.label) not in relations:
@@ -946,6 +962,7 @@ class OfflineParser:
         # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
         text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", THATS_IT.sub("", text)))
         text = INSIST.sub(" ", text)
+        text = ON_ENTERING.sub(r" in \1", ON_THE_WALL.sub("", text))
         text = CLOSER_THAN.sub(r"near \1", FAR_FROM.sub("", ITS_SIDE.sub("", HABIT.sub(" ", text))))
         for first in (KIND_FIRST, NEGATED_FIRST):
             m = first.match(text)

@@ -868,3 +868,20 @@ def test_more_names_of_rooms(parser, where, room) -> None:
 
 def test_the_loo_alone_is_the_toilet(parser) -> None:
     assert parser.parse("take me to the loo").targets == ("toilet",)
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    ("Find the plant just past the sofa.", "plant", (("plant", "near", "sofa"),)),  # the sofa was the target
+    ("Find the plant beyond the sofa.", "plant", (("plant", "near", "sofa"),)),
+    ("Find the armchair overlooking the window.", "armchair", (("armchair", "facing", "window"),)),  # the window
+    ("Find the tv attached to the wall opposite the bed.", "tv", (("tv", "opposite", "bed"),)),  # a "tv_attached_to_wall"
+    ("Find the plant all the way at the end of the hallway.", "plant", (("plant", "in", "hallway"),)),  # a "plant_all_way"
+    ("Find the chair at the far end of the kitchen.", "chair", (("chair", "in", "kitchen"),)),  # "at" the kitchen too
+    ("Find the chair to the left when you enter the kitchen.", "chair", (("chair", "in", "kitchen"),)),
+    ("Find the stool at the breakfast bar.", "stool", (("stool", "at", "counter_top"),)),
+    ("next to the fridge", "fridge", ()),  # no object found: the only object named is where to go
+])
+def test_more_relations_and_places(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
