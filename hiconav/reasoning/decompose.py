@@ -24,6 +24,7 @@ from __future__ import annotations
 import functools
 import logging
 import re
+import unicodedata
 from collections.abc import Callable, Collection, Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -441,6 +442,13 @@ ON_THE_WALL = re.compile(r"\s+(?:attached|fixed|fastened|mounted|screwed|bolted|
 # "to the left when you enter the kitchen": the room entered is the one it is in
 ON_ENTERING = re.compile(r"\s+(?:as|when|once|after)\s+you\s+(?:enter|come in(?:to)?|walk in(?:to)?|go in(?:to)?|step into|"
                          r"get into)\s+((?:the|a)\s+[a-z' ]+?)(?=\s*(?:[,.;!?]|$))")
+# a correction at a clause's start, followed by what is meant (not "the one ...", which refines)
+CORRECTION = re.compile(r"(?:^|[.,;!?]\s*)(?:no|nope|actually|oh wait|wait|sorry|i mean|i meant|scratch that|make that|"
+                        r"correction|or rather)\s*,?\s+(?!the one\b|one\b)"
+                        r"(?=(?:find|go|take|locate|navigate|head|make|the|a|an|to|my)\b)")
+# a request not to go somewhere, before the one that counts ("don't go to the sofa, go to ...")
+DONT = re.compile(r"^(?:please\s+)?(?:don't|do not|never)\s+(?:go to|find|take me to|look for|head to|walk to|navigate to)"
+                  r"\b[^,.;!?]*[,.;!?]\s*(?:but\s+|instead\s+)?(?=\S)")
 # "take me to where the bed is", "the place where the tv is": the object
 WHERE_IT_IS = re.compile(r"\b(?:the (?:place|spot|room|area)\s+)?where\s+((?:the|a|an|my|your|our)\s+[a-z' ]+?)\s+(?:is|are)\b")
 # a step of the way that names no object to find ("turn left and find the plant", "go down the
@@ -555,11 +563,12 @@ FILLERS = frozenset([
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
     "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also", "whatever", "whichever",
-    "anywhere", "together", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
+    "anywhere", "together", "actually", "currently", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
-                       "thanks", "thank", "you", "so", "um", "uh", "well"])
+                       "thanks", "thank", "you", "so", "um", "uh", "well", "no", "nope", "yes", "yeah", "sorry",
+                       "wait", "oh"])
 # what introduces the object after a relation said first ("in the bedroom there is a TV")
 EXISTENTIALS: tuple[str, ...] = tuple(sorted((
     "there is", "there's", "there are", "there sits", "there stands", "there hangs", "you will find",
@@ -948,8 +957,12 @@ class OfflineParser:
     # ------------------------------------------------------------------ steps
     @staticmethod
     def _sentences(text: str) -> list[str]:
+        # accents are letters ("the sofá", "the café table"), not word breaks
+        text = "".join(c for c in unicodedata.normalize("NFKD", text) if not unicodedata.combining(c))
         text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
         text = re.sub(r"[\"“”()\[\]{}:]", " ", text)
+        # "the chair & the table", "chair+sofa": and; "chair/sofa": or
+        text = re.sub(r"\s*[&+]\s*", " and ", re.sub(r"(?<=[a-z])/(?=[a-z])", " or ", text))
         # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
         text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
@@ -973,7 +986,13 @@ class OfflineParser:
         # a decimal point ends no sentence ("1.5 m from the fridge")
         text = re.sub(r"(\d)\.(\d)", r"\1\2", text)
         # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
-        text = re.sub(r"\b(?:[a-z]\.){2,}", lambda m: m.group(0).replace(".", "") + " ", text)
+        text = re.sub(r"\b(?:[a-z]\.){2,}|\b(?:[a-z]\.)+[a-z]\b", lambda m: m.group(0).replace(".", "") + " ", text)
+        # the speaker corrects themself ("find the couch; no, the armchair", "go to the bed, oh
+        # wait, the sofa"): what follows the last correction is what is meant
+        fixes = list(CORRECTION.finditer(text))
+        if fixes:
+            text = text[fixes[-1].end():]
+        text = DONT.sub("", text)
         parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+|but\s+|so\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"
                          r"(?:find|look|go|search|locate|navigate|take|walk|head|bring|show|get|stop|wait|stand|"
                          r"approach|proceed|travel|move|turn|enter|exit|leave|follow|continue|keep)\b)"

@@ -885,3 +885,21 @@ def test_more_relations_and_places(parser, text, target, relations) -> None:
     task = parser.parse(text)
     assert task.targets == (target,)
     assert task.relations == relations
+
+
+@pytest.mark.parametrize("text,targets", [
+    # the speaker corrects themself: the couch was the target
+    ("find the couch; no, the armchair", ("armchair",)),
+    ("find the couch - actually, the armchair", ("armchair",)),
+    ("find the sofa. Actually, find the armchair instead.", ("armchair",)),
+    ("go to the bed, oh wait, the sofa", ("sofa",)),  # targets bed, "oh_wait", sofa
+    ("don't go to the sofa, go to the armchair", ("armchair",)),
+    ("find a chair, no, the one next to the fridge", ("chair",)),  # refines, corrects nothing; a target "no"
+    # written forms: an accent ("sof"), a slash or an ampersand, a dotted abbreviation without its last dot ("t")
+    ("find the sofá", ("sofa",)),
+    ("find the chair/sofa", ("chair", "sofa")),
+    ("find the chair & the table", ("chair", "dining_table")),
+    ("find the T.V", ("tv",)),
+])
+def test_corrections_and_written_forms(parser, text, targets) -> None:
+    assert parser.parse(text).targets == targets
