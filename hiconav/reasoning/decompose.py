@@ -449,6 +449,46 @@ CORRECTION = re.compile(r"(?:^|[.,;!?]\s*)(?:no|nope|actually|oh wait|wait|sorry
 # a request not to go somewhere, before the one that counts ("don't go to the sofa, go to ...")
 DONT = re.compile(r"^(?:please\s+)?(?:don't|do not|never)\s+(?:go to|find|take me to|look for|head to|walk to|navigate to)"
                   r"\b[^,.;!?]*[,.;!?]\s*(?:but\s+|instead\s+)?(?=\S)")
+# what the speaker needs to do, for the object one does it with ("where can I wash my hands?",
+# "find something to sit on", "I want to make coffee"): (need, the object's name)
+NEEDS: tuple[tuple[str, str], ...] = (
+    (r"sit(?: down)?", "chair"), (r"sleep|lie down|lay down|take a nap|have a nap|nap", "bed"),
+    (r"relax|rest|lounge|chill out|put my feet up", "sofa"),
+    (r"wash (?:my |our |your )?hands|wash up|brush (?:my |our )?teeth|wash (?:my |our )?face", "sink"),
+    (r"cook|fry|boil (?:some )?(?:water|eggs|pasta)", "stove"),
+    (r"watch (?:tv|television|the news|a movie|a film|a show|the game)", "tv"),
+    (r"keep (?:the |my |our )?(?:food|milk|drinks) cold|get a cold drink|chill (?:my |the |a )?(?:drink|drinks|beer|wine)",
+     "fridge"),
+    (r"(?:heat|warm|reheat) (?:up )?(?:my |our |the |some )?(?:food|leftovers|lunch|dinner|meal)|reheat", "microwave"),
+    (r"make (?:a |some )?(?:cup of |pot of )?coffee|brew (?:some )?coffee|get (?:a |some )?coffee", "coffee machine"),
+    (r"make (?:some )?toast|toast (?:some |my )?bread", "toaster"),
+    (r"wash (?:my |our |the )?clothes|do (?:the |my |some )?laundry", "washing machine"),
+    (r"dry (?:my |our |the )?clothes|dry (?:the |my )?laundry", "clothes dryer"),
+    (r"throw (?:this|it|something|that|the trash|the rubbish|the garbage|trash|rubbish|garbage)? ?away|"
+     r"dispose of (?:this|it|something)|get rid of (?:this|it|some trash)", "garbage can"),
+    (r"put (?:my |our |the )?(?:dirty )?(?:clothes|laundry)", "laundry hamper"),
+    (r"use the (?:toilet|bathroom|restroom|loo|lavatory)|pee|poop|go potty", "toilet"),
+    (r"take a bath|have a bath|bathe|have a soak", "bathtub"),
+    (r"work|study|do (?:my |some )?homework|write", "desk"),
+)
+NEED_ASK = re.compile(
+    r"^(?:where (?:can|do|could|should|would|may) (?:i|we)|(?:find|show|get|take|bring|lead|guide)(?: me| us)?(?: to)?\s+"
+    r"(?:somewhere|something|a place|a spot|anywhere|a good (?:place|spot))(?: (?:comfy|comfortable|nice|good|quiet|warm))?"
+    r"(?: (?:where|so) (?:i|we) can| (?:i|we) can| to| for)?|(?:i|we) (?:need|want|would like|'d like|have) to|"
+    r"(?:i|we) (?:need|want) (?:somewhere|something|a place) to|(?:somewhere|something|a place) to)\s+"
+    r"(?P<need>" + "|".join(f"(?:{need})" for need, _ in NEEDS) + r")\b(?P<rest>[a-z' ]*)$")
+
+
+def _need_object(part: str) -> str | None:
+    """The name of the object with which one does what the part asks to do, or None."""
+    m = NEED_ASK.match(part)
+    if m is None or (m.group("rest").strip() and not re.fullmatch(r"\s*(?:on|in|at|with|please|now|here)?\s*",
+                                                                  m.group("rest"))):
+        return None  # "I want to sit on the sofa" names its object: ACTIVITY's rule
+    need = m.group("need")
+    return next(name for pattern, name in NEEDS if re.fullmatch(pattern, need))
+
+
 # "take me to where the bed is", "the place where the tv is": the object
 WHERE_IT_IS = re.compile(r"\b(?:the (?:place|spot|room|area)\s+)?where\s+((?:the|a|an|my|your|our)\s+[a-z' ]+?)\s+(?:is|are)\b")
 # a step of the way that names no object to find ("turn left and find the plant", "go down the
@@ -1010,6 +1050,9 @@ class OfflineParser:
             part = SPEAKER_STATE.sub("", part).strip()
             part = ACTIVITY.sub("go to ", part)
             part = " ".join(WANTED.sub(" ", part).split())
+            needed = _need_object(part.replace(" ?", "").strip())
+            if needed is not None:
+                part = f"find the {needed}"
             part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", LEAD_IN.sub("", part)))
             part = HEDGE.sub("", MOTION_OVER.sub("go to", part)).strip()
             part = WHERE_IT_IS.sub(r"\1", part)

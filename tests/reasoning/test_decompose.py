@@ -903,3 +903,24 @@ def test_more_relations_and_places(parser, text, target, relations) -> None:
 ])
 def test_corrections_and_written_forms(parser, text, targets) -> None:
     assert parser.parse(text).targets == targets
+
+
+@pytest.mark.parametrize("text,target", [
+    # what the speaker needs to do names the object one does it with (was "something_to",
+    # "where_can_i_wash_hand", "to_make_coffee", ...)
+    ("find something to sit on", "chair"), ("take me to a place where I can sit", "chair"),
+    ("where can I wash my hands?", "sink"), ("where can I keep food cold?", "fridge"),
+    ("find something to heat up my food", "microwave"), ("I want to make coffee", "coffee_machine"),
+    ("where can I wash my clothes?", "washing_machine"), ("I need to dry my clothes", "clothes_dryer"),
+    ("where do I throw this away?", "garbage_can"), ("where can I put my dirty clothes?", "laundry_hamper"),
+    ("find a place to work", "desk"), ("find somewhere comfy to relax", "sofa"), ("where can I lie down?", "bed"),
+    ("I want to sit on the sofa", "sofa"),  # the object named wins
+])
+def test_what_the_speaker_needs_to_do(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,) and not task.attributes
+
+
+def test_a_room_alone_is_still_no_object(parser) -> None:
+    with pytest.raises(InstructionError):
+        parser.parse("I want to go to the kitchen")
