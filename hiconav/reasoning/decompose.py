@@ -346,6 +346,9 @@ how do i get to|how can i get to|where do you keep|where would i find|where can 
 i wanna see|i want to see|i'd like to see|i would like to see|i think there's|i think there is|i believe|
 explore until you find|explore until you see|keep exploring until you find|keep exploring until you see|
 search the house for|search the whole house for|going to|heading to|walking to|can u|could u|would u|you'll find|you will find|you can find|
+identify|identify and approach|locate and approach|find and approach|identify and move to|move to|
+navigate through the house until you locate|navigate through the house until you find|explore until you locate|
+your objective is to reach|your objective is to find|your goal is to reach|your goal is to find|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
@@ -489,6 +492,23 @@ def _need_object(part: str) -> str | None:
     return next(name for pattern, name in NEEDS if re.fullmatch(pattern, need))
 
 
+# written as fields ("Goal: chair. Location: kitchen, next to the fridge.", "landmark: fridge")
+FIELDS = ((re.compile(r"\b(?:object|target|goal|item)\s*:\s*"), "find the "),
+          (re.compile(r"\b(?:location|room|place|area)\s*:\s*"), "it is in the "),
+          (re.compile(r"\b(?:landmark|near|next to|reference)\s*:\s*"), "it is near the "),
+          (re.compile(r"\b(?:hint|note|tip|clue|fyi)\s*:\s*"), ""))
+# clause words that name nothing: "which can be found lying on the bed", "the chair which you will
+# find beside the fridge", "that happens to be", "that's been placed", "the one that's got a
+# painting above it", "the location of the toilet"
+HEDGED_BE = re.compile(r"\b(?:which|that|who)?\s*(?:can|could|may|might|will|would|should)\s+be\s+(?:found|seen|located|spotted)\b"
+                       r"|\b(?:which|that)\s+you(?:'ll|\s+will|\s+can|\s+should|\s+would|\s+may|\s+might)?\s+(?:find|see|spot|notice)\b"
+                       r"|\b(?:happens|happen|appears|appear|seems|seem|tends|tend)\s+to\s+be\b"
+                       r"|(?:'s|\s+has|\s+have|\s+had)\s+been\b")
+HAS_GOT = re.compile(r"(?:'s|\s+has|\s+have)\s+got\b")
+PLACE_OF = re.compile(r"(?<!\bin )(?<!within )\bthe\s+(?:location|position|vicinity|whereabouts|area|spot|place)\s+of\s+(?=the\b|a\b|an\b)")
+# ", where you should find the toilet": what is found there is what to find
+WHERE_YOU_FIND = re.compile(r",?\s+where\s+(?:you|one|we)\s+(?:should|will|can|could|would|might|may|'ll)?\s*"
+                            r"(?:find|see|spot|notice|discover)\s+")
 # "take me to where the bed is", "the place where the tv is": the object
 WHERE_IT_IS = re.compile(r"\b(?:the (?:place|spot|room|area)\s+)?where\s+((?:the|a|an|my|your|our)\s+[a-z' ]+?)\s+(?:is|are)\b")
 # a step of the way that names no object to find ("turn left and find the plant", "go down the
@@ -565,6 +585,7 @@ RELATIONS: dict[str, str] = {
     # just beyond another object ("the plant just past the sofa" made the sofa the target)
     "past": "near", "beyond": "near", "just past": "near", "just beyond": "near",
     "overlooking": "facing", "looking out of": "facing", "looking out": "facing", "looking onto": "facing",
+    "illuminates": "near", "illuminating": "near", "lights up": "near", "lighting up": "near", "shines on": "near",
     # which way it is turned ("the sofa that faces the tv" made the tv the target)
     "faces": "facing", "face": "facing", "facing towards": "facing", "facing toward": "facing",
     "pointed at": "facing", "pointing at": "facing", "pointing towards": "facing", "turned towards": "facing",
@@ -603,7 +624,7 @@ FILLERS = frozenset([
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
     "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also", "whatever", "whichever",
-    "anywhere", "together", "actually", "currently", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
+    "anywhere", "together", "actually", "currently", "hint", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -1000,7 +1021,11 @@ class OfflineParser:
         # accents are letters ("the sofá", "the café table"), not word breaks
         text = "".join(c for c in unicodedata.normalize("NFKD", text) if not unicodedata.combining(c))
         text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
+        for form, said in FIELDS:
+            text = form.sub(said, text)
         text = re.sub(r"[\"“”()\[\]{}:]", " ", text)
+        text = PLACE_OF.sub("", WHERE_YOU_FIND.sub(". find ", text))
+        text = HAS_GOT.sub(" has", HEDGED_BE.sub(" ", text))
         # "the chair & the table", "chair+sofa": and; "chair/sofa": or
         text = re.sub(r"\s*[&+]\s*", " and ", re.sub(r"(?<=[a-z])/(?=[a-z])", " or ", text))
         # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
@@ -1037,7 +1062,8 @@ class OfflineParser:
                          r"(?:find|look|go|search|locate|navigate|take|walk|head|bring|show|get|stop|wait|stand|"
                          r"approach|proceed|travel|move|turn|enter|exit|leave|follow|continue|keep)\b)"
                          r"|\s+and\s+(?=(?:find|look for|search for|locate|go|walk|head|stop|wait|stand|approach|"
-                         r"proceed|travel|move|navigate|enter|check|make your way|take me|bring me)\b)", text)
+                         r"proceed|travel|move|navigate|enter|check|make your way|take me|bring me|identify|spot|reach|"
+                         r"visit)\b)", text)
         out = []
         for part in parts:
             part = re.sub(r"[^a-z0-9' \-,]", " ", part)

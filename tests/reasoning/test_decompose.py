@@ -924,3 +924,30 @@ def test_what_the_speaker_needs_to_do(parser, text, target) -> None:
 def test_a_room_alone_is_still_no_object(parser) -> None:
     with pytest.raises(InstructionError):
         parser.parse("I want to go to the kitchen")
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # long-winded requests as a language model words them
+    ("Proceed towards the kitchen and identify the chair that stands in close proximity to the refrigerator.",
+     "chair", (("chair", "near", "fridge"), ("chair", "in", "kitchen"))),  # the kitchen near the fridge
+    ("Head over to the bathroom, where you should find the toilet positioned next to the bathtub.",
+     "toilet", (("toilet", "next to", "bathtub"), ("toilet", "in", "bathroom"))),  # the bathroom next to the bathtub
+    ("Navigate to the desk lamp that illuminates the desk.", "desk_lamp", (("desk_lamp", "near", "desk"),)),  # the desk
+    ("The target object is a laptop, which can be found lying on the bed.", "laptop", (("laptop", "on", "bed"),)),  # a "can"
+    ("Go to the chair which you will find beside the fridge.", "chair", (("chair", "next to", "fridge"),)),
+    ("Find the chair that happens to be next to the fridge.", "chair", (("chair", "next to", "fridge"),)),
+    ("Find the chair, which seems to be by the fridge.", "chair", (("chair", "next to", "fridge"),)),
+    ("Find the chair that's been placed next to the fridge.", "chair", (("chair", "next to", "fridge"),)),
+    ("Walk towards the bed, the one that's got a painting hanging above it.", "bed",
+     (("bed", "with", "painting"), ("painting", "above", "bed"))),  # the painting a second target
+    ("Move to the location of the toilet in the bathroom.", "toilet", (("toilet", "in", "bathroom"),)),  # a "location"
+    ("Navigate to the vicinity of the fridge.", "fridge", ()),
+    ("Locate the chair. Hint: it is next to the fridge.", "chair", (("chair", "next to", "fridge"),)),  # a "hint"
+    ("Goal: chair. Location: kitchen, next to the fridge.", "chair", (("chair", "in", "kitchen"), ("chair", "next to", "fridge"))),
+    ("Object: chair; room: kitchen; landmark: fridge.", "chair", (("chair", "in", "kitchen"), ("chair", "near", "fridge"))),
+])
+def test_long_winded_and_field_forms(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert not task.attributes
