@@ -509,6 +509,22 @@ PLACE_OF = re.compile(r"(?<!\bin )(?<!within )\bthe\s+(?:location|position|vicin
 # ", where you should find the toilet": what is found there is what to find
 WHERE_YOU_FIND = re.compile(r",?\s+where\s+(?:you|one|we)\s+(?:should|will|can|could|would|might|may|'ll)?\s*"
                             r"(?:find|see|spot|notice|discover)\s+")
+# a chore done at an object is a request to go to it ("turn on the TV" sought a "turn" on the
+# tv; "look under the bed" a "look"; "take a seat on the sofa" a chair on the sofa; "grab me a
+# drink from the fridge" a "me_drink"; "check if the stove is off" an "if_stove_off")
+CHORE = re.compile(
+    r"^(?:(?:please|go|go and|now)\s+)*(?:(?:water|turn on|turn off|switch on|switch off|open|close|shut|make|clean|"
+    r"empty|charge|tidy up|tidy|dust|start|unplug|plug in|wipe down|wipe|fix|fill up|fill|load|unload|check on|"
+    r"use)(?=\s+(?:the|my|our|your|a|an|that|this)\b)(?!\s+your\s+way\b)|(?:sit|lie|lie down|lay down|sit down|take a seat|have a seat|"
+    r"take a nap|have a nap)\s+(?:on|in|at|by|next to)|(?:look|check|search|vacuum|clean)\s+(?:under|behind|inside|"
+    r"beneath|underneath|around|on top of|in)(?=\s+(?:the|my|our|your|a|an)\b))")
+CONSUMABLE_FROM = re.compile(
+    r"^(?:(?:please|go|go and)\s+)*(?:get|grab|fetch|bring)(?:\s+(?:me|us))?\s+(?:a|an|some|the|my)?\s*(?:cold\s+)?"
+    r"(?:drink|snack|beer|soda|water|juice|milk|food|bite|something to drink|something to eat|something cold|ice)"
+    r"\s+(?:from|out of)\s+")
+STATE_CHECK = re.compile(r"^(?:check|see|look|find out)\s+(?:if|whether|that)\s+((?:the|my|our)\s+[a-z' ]+?)\s+"
+                         r"(?:is|are)\s+(?:still\s+)?(?:on|off|open|closed|shut|clean|dirty|running|working|plugged in|"
+                         r"unplugged|empty|full|locked|unlocked|there)\b.*$")
 # "take me to where the bed is", "the place where the tv is": the object
 WHERE_IT_IS = re.compile(r"\b(?:the (?:place|spot|room|area)\s+)?where\s+((?:the|a|an|my|your|our)\s+[a-z' ]+?)\s+(?:is|are)\b")
 # a step of the way that names no object to find ("turn left and find the plant", "go down the
@@ -1076,6 +1092,7 @@ class OfflineParser:
             part = SPEAKER_STATE.sub("", part).strip()
             part = ACTIVITY.sub("go to ", part)
             part = " ".join(WANTED.sub(" ", part).split())
+            part = STATE_CHECK.sub(r"go to \1", CONSUMABLE_FROM.sub("go to ", CHORE.sub("go to", part)))
             needed = _need_object(part.replace(" ?", "").strip())
             if needed is not None:
                 part = f"find the {needed}"

@@ -951,3 +951,21 @@ def test_long_winded_and_field_forms(parser, text, target, relations) -> None:
     assert task.targets == (target,)
     assert task.relations == relations
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,target", [
+    # a chore at an object is a request to go to it
+    ("Turn on the TV.", "tv"),  # a "turn" on the tv
+    ("Lie down on the bed.", "bed"),  # a "lie_down"
+    ("Look under the bed.", "bed"), ("Look behind the sofa.", "sofa"),  # a "look"
+    ("Take a seat on the sofa.", "sofa"),  # a chair on the sofa
+    ("Have a seat in the armchair.", "armchair"),
+    ("Grab me a drink from the fridge.", "fridge"),  # a "me_drink"
+    ("Check if the stove is off.", "stove"),  # an "if_stove_off"
+    ("Water the plant.", "plant"), ("Switch off the lamp.", "floor_lamp"), ("Empty the trash can.", "garbage_can"),
+    ("Go and turn off the TV.", "tv"), ("Vacuum under the bed.", "bed"),  # a vacuum cleaner
+    ("make your way to the fridge", "fridge"),  # "make" is no chore here
+])
+def test_chores_at_an_object(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,) and not task.attributes and not task.relations
