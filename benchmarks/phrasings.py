@@ -10,7 +10,8 @@ to it."), a room in the possessive ("the kitchen's chair"), a dashed afterthough
 next to the fridge - go there"), the target called by another name, what to do on arrival
 ("... and stop there"), the speaker's reason ("... so I can have a look, thanks"), steps of the
 way first ("Go down the hall, turn left and stop by ..."), who wants it ("The chair I want is the
-one next to the fridge."), a typing slip ("the armhcair ..."). A parser that
+one next to the fridge."), the goal said as a predicate ("Explore and find it: the ... is my
+destination."), a typing slip ("the armhcair ..."). A parser that
 reads only the templates loses the description and stops at the first instance of the category
 it sees.
 
@@ -99,6 +100,7 @@ def forms(instruction: str, target: str) -> dict[str, str]:
     out["reason"] = f"bring me to the {name} {rest} so I can have a look, thanks"
     out["route"] = f"Go down the hall, turn left and stop by the {name} {rest}"
     out["wanted"] = f"The {name} I want is the one {rest}."
+    out["destination"] = f"Explore and find it: the {name} {rest} is my destination."
     slipped = slip(name)
     if slipped != name:
         out["slip"] = f"find the {slipped} {rest}"

@@ -517,7 +517,7 @@ CHORE = re.compile(
     r"empty|charge|tidy up|tidy|dust|start|unplug|plug in|wipe down|wipe|fix|fill up|fill|load|unload|check on|"
     r"use)(?=\s+(?:the|my|our|your|a|an|that|this)\b)(?!\s+your\s+way\b)|(?:sit|lie|lie down|lay down|sit down|take a seat|have a seat|"
     r"take a nap|have a nap)\s+(?:on|in|at|by|next to)|(?:look|check|search|vacuum|clean)\s+(?:under|behind|inside|"
-    r"beneath|underneath|around|on top of|in)(?=\s+(?:the|my|our|your|a|an)\b))")
+    r"beneath|underneath|on top of|in)(?=\s+(?:the|my|our|your|a|an)\b))")
 CONSUMABLE_FROM = re.compile(
     r"^(?:(?:please|go|go and)\s+)*(?:get|grab|fetch|bring)(?:\s+(?:me|us))?\s+(?:a|an|some|the|my)?\s*(?:cold\s+)?"
     r"(?:drink|snack|beer|soda|water|juice|milk|food|bite|something to drink|something to eat|something cold|ice)"
@@ -535,6 +535,10 @@ ROUTE_STEP = re.compile(
     r"take the (?:stairs|elevator|lift|hallway|hall|corridor)|go straight|walk straight|go (?:up|down)stairs|"
     r"(?:go|walk|head|move|drive|continue|keep)\s+(?:down(?!\s+to\b)|along|through|past|across|up(?!\s+to\b)|"
     r"out of|out|back(?!\s+to\b)|straight|forward|ahead|around|on))\b")
+# a clause that only says to explore ("explore and find the chair", "look around the house")
+EXPLORE_ONLY = re.compile(r"(?:(?:please|now|first|just)\s+)*(?:explore|look around|search around|wander|wander around|"
+                          r"roam|roam around|move around|walk around|go around|have a look around)"
+                          r"(?:\s+(?:the\s+)?(?:house|place|area|apartment|flat|home|rooms|a bit|for a bit))?")
 # who wants what, before what it is: "the chair you want is next to the fridge", "what I'm
 # looking for is the armchair by the lamp", "the object you're looking for is a chair"
 WANTED = re.compile(
@@ -547,7 +551,14 @@ WANTED = re.compile(
 PURPOSE = re.compile(r",?\s+(?:so that|so|because|since|in order that)\s+(?:i|we|i'd|we'd|i'm|we're)\b[^.!?;]*")
 FINAL_COURTESY = re.compile(
     r"(?:,?\s*\b(?:please|pls|plz|thanks|thank you|thanks a lot|thx|ty|cheers|asap|quickly|right away|"
-    r"immediately|straight away|now|real quick))+\s*[.!]*\s*$")
+    r"immediately|straight away|now|real quick|as (?:quickly|fast|soon) as (?:possible|you can)|when you can|"
+    r"if you can|if possible|whenever you can|in a hurry|fast))+\s*[.!]*\s*$")
+# the object said to be the goal ("The dining table in the kitchen is my destination.", "...
+# is where I want to go", "... is what I'm looking for")
+GOAL_PREDICATE = re.compile(
+    r"\s+(?:is|will be)\s+(?:my|our|your|the)\s+(?:destination|goal|target|objective|aim)\b|"
+    r"\s+is\s+where\s+(?:i|we)\s+(?:want|need|'d like|would like)\s+(?:you\s+)?to\s+(?:go|be)\b|"
+    r"\s+is\s+what\s+(?:i|we)(?:'m|\s+am|'re|\s+are)\s+(?:looking for|after)\b")
 # "I'm hungry, ...", "I am so tired": the speaker's state, before what they ask
 SPEAKER_STATE = re.compile(
     r"^(?:i'm|i am|we're|we are|i feel|i'm feeling|i am feeling)\s+(?:so |very |really |a bit |kind of )?"
@@ -1055,7 +1066,7 @@ class OfflineParser:
         # what to do on arrival names no object: "go to the chair by the fridge and stop there";
         # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
         text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", THATS_IT.sub("", text)))
-        text = INSIST.sub(" ", text)
+        text = GOAL_PREDICATE.sub("", INSIST.sub(" ", text))
         text = ON_ENTERING.sub(r" in \1", ON_THE_WALL.sub("", text))
         text = CLOSER_THAN.sub(r"near \1", FAR_FROM.sub("", ITS_SIDE.sub("", HABIT.sub(" ", text))))
         for first in (KIND_FIRST, NEGATED_FIRST):
@@ -1103,7 +1114,7 @@ class OfflineParser:
             part = " ".join(re.sub(r"\brather than\b", "not", part).split())
             if part:
                 out.append(part)
-        kept = [p for p in out if not ROUTE_STEP.match(p)]
+        kept = [p for p in out if not ROUTE_STEP.match(p) and not EXPLORE_ONLY.fullmatch(p)]
         return kept or out
 
     @staticmethod

@@ -969,3 +969,16 @@ def test_long_winded_and_field_forms(parser, text, target, relations) -> None:
 def test_chores_at_an_object(parser, text, target) -> None:
     task = parser.parse(text)
     assert task.targets == (target,) and not task.attributes and not task.relations
+
+
+@pytest.mark.parametrize("text", [
+    "The chair next to the fridge is my destination.",  # a room-less "fridge_destination"
+    "The chair next to the fridge is where I want to go.",
+    "Please find the chair next to the fridge as quickly as possible.",  # a "fridge_as_quickly_as_possible"
+    "Explore and find the chair next to the fridge.",  # an "explore"
+    "Look around the house and find the chair next to the fridge.",
+])
+def test_goal_said_as_a_predicate_haste_and_exploring(parser, text) -> None:
+    task = parser.parse(text)
+    assert task.targets == ("chair",)
+    assert task.relations == (("chair", "next to", "fridge"),)
