@@ -349,6 +349,11 @@ search the house for|search the whole house for|going to|heading to|walking to|c
 identify|identify and approach|locate and approach|find and approach|identify and move to|move to|
 navigate through the house until you locate|navigate through the house until you find|explore until you locate|
 your objective is to reach|your objective is to find|your goal is to reach|your goal is to find|
+navigate until you reach|drive until you reach|go until you reach|keep going until you reach|explore until you reach|
+i want to reach|i need to reach|i'd like to reach|i would like to reach|i'm searching for|i am searching for|
+searching for|i'm trying to find|i am trying to find|trying to find|my destination is|our destination is|
+your destination is|the destination is|destination|
+i'd like to be taken to|i would like to be taken to|i want to be taken to|i need to be taken to|
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
@@ -371,6 +376,8 @@ LEAD_IN = re.compile(
     r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh)\s*(?:,\s*|$)|"
     r"(?:so\s+|um\s+|okay\s+|ok\s+)*(?:i was wondering if you could|i'd appreciate it if you could|"
     r"i would appreciate it if you could|would you mind|would you be so kind as to|do you know where|"
+    r"i'd love it if you could|i would love it if you could|it would be great if you could|it'd be great if you could|"
+    r"it would be nice if you could|i'd be grateful if you could|i would be grateful if you could|"
     r"can you tell me where|could you tell me where|let me know when you reach|let me know when you find|"
     r"it's time to|time to|basically|(?:the )?robot (?:should|must|needs to|has to|will|can)|"
     r"you need to|you have to|you must|you should|you are looking for|you're looking for|we are looking for|"
@@ -391,7 +398,7 @@ VIEWER_SIDE = re.compile(r"\s+(?:to|on) the (?:left|right)(?:\s+(?:hand\s+)?side
 MOTION_OVER = re.compile(r"^(?:please\s+)?(?:drive|roll|move|scoot|hop|run|pop|wander|stroll|zip|dash|hurry|rush|"
                          r"travel|navigate|get|come|go|head|walk|swing|nip|trot)\s+(?:on\s+)?over\s+to\b")
 # "first, ...", "step 2: ...", "finally ...": the order of the steps names no object
-STEP_MARKER = re.compile(r"^(?:step\s+\d+\s*,?\s*|(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|next|quick|quickly|hurry|"
+STEP_MARKER = re.compile(r"^(?:step\s+\d+\s*,?\s*|(?:quick|quickly)\s+(?=the\b|a\b|an\b)|(?:first(?:ly)?|second(?:ly)?|third(?:ly)?|next|quick|quickly|hurry|"
                          r"hurry up)\s*(?:,\s*|$)|(?:finally|lastly|after that|afterwards)\s*,?\s*)")
 # a hedge about where it is names nothing ("I'm not sure where it is, but ..."); words that only
 # hedge open a clause ("Somewhere in this house there's a teddy bear")
@@ -493,7 +500,7 @@ def _need_object(part: str) -> str | None:
 
 
 # written as fields ("Goal: chair. Location: kitchen, next to the fridge.", "landmark: fridge")
-FIELDS = ((re.compile(r"\b(?:object|target|goal|item)\s*:\s*"), "find the "),
+FIELDS = ((re.compile(r"\b(?:object|target|goal|item|destination)\s*:\s*"), "find the "),
           (re.compile(r"\b(?:location|room|place|area)\s*:\s*"), "it is in the "),
           (re.compile(r"\b(?:landmark|near|next to|reference)\s*:\s*"), "it is near the "),
           (re.compile(r"\b(?:hint|note|tip|clue|fyi)\s*:\s*"), ""))
@@ -1057,7 +1064,7 @@ class OfflineParser:
         text = re.sub(r"\s*[&+]\s*", " and ", re.sub(r"(?<=[a-z])/(?=[a-z])", " or ", text))
         # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
         # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
-        text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", ". ", text)
+        text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", " ; ", text)
         text = re.sub(r"\bas well as\b", "and", text)
         text = WHICHEVER.sub("", text)
         # why the speaker asks names no object ("bring me to the tv so I can watch the news")
@@ -1375,6 +1382,11 @@ class OfflineParser:
             label2, known2 = self.canonical(rest[-1])
             if known2:
                 return NounPhrase(label2, tuple(attrs + rest[:-1]), text, True)
+            if len(rest) > 2:
+                # a name no table holds, after words the rules did not take ("until you reach
+                # the john"): the head and its modifier, not the words before them
+                label3, known3 = self.canonical(" ".join(rest[-2:]))
+                return NounPhrase(label3, tuple(attrs), text, known3)
         return NounPhrase(label, tuple(attrs), text, known)
 
     def _most_similar(self, phrase: str) -> tuple[str | None, float]:

@@ -982,3 +982,19 @@ def test_goal_said_as_a_predicate_haste_and_exploring(parser, text) -> None:
     task = parser.parse(text)
     assert task.targets == ("chair",)
     assert task.relations == (("chair", "next to", "fridge"),)
+
+
+@pytest.mark.parametrize("text", [
+    # a name no table holds keeps only itself, not the request's words before it
+    "Navigate until you reach the john.",  # an "until_you_reach_john"
+    "I'd love it if you could find the john.", "It would be great if you could go to the john.",
+    "Quick: the john!", "I'd like to be taken to the john.", "I want to reach the john.",
+    "My destination is the john.", "Your destination: the john.", "I'm searching for the john.",
+    "The john - go there now.",
+])
+def test_an_unknown_name_keeps_only_itself(parser, text) -> None:
+    assert parser.parse(text).targets == ("john",)
+
+
+def test_a_dash_after_a_dotted_abbreviation_still_parts_clauses(parser) -> None:
+    assert parser.parse("The t.v - go there now.").targets == ("tv",)  # a "tv_go"
