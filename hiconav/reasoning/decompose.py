@@ -217,7 +217,8 @@ ROOM_QUALIFIERS = frozenset(["first", "second", "third", "fourth", "other", "mai
                              "big", "bigger", "large", "larger", "little", "en", "suite", "ensuite",
                              "biggest", "largest", "smallest", "tiny", "huge", "nearest", "closest",
                              "farthest", "furthest", "last", "only", "left", "right", "upper", "lower",
-                             "top", "ground", "middle", "new", "old"])
+                             "top", "ground", "middle", "new", "old", "1st", "2nd", "3rd", "4th", "kids'",
+                             "childrens", "girls", "boys", "girls'", "boys'", "girl's", "boy's", "teen", "teenager's"])
 
 # Co-occurrence priors (common sense of household layouts): label -> related objects, most
 # telling first. Entries not in the active vocabulary are dropped.
@@ -1342,6 +1343,9 @@ class OfflineParser:
         if spelt != words and any(" ".join(spelt[-n:]) in ROOMS for n in (1, 2, 3)):
             words = spelt
         text = " ".join(words)
+        # someone's room ("mom's room", "my son's room", "the kids' room") is a bedroom
+        if len(words) >= 2 and words[-1] == "room" and re.fullmatch(r"[a-z]+(?:'s|s')", words[-2]):
+            return NounPhrase("bedroom", (), text, False, room="bedroom")
         # Rooms ("the kitchen", "the master bedroom").
         for n in range(min(3, len(words)), 0, -1):
             tail = " ".join(words[-n:])

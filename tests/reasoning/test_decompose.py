@@ -998,3 +998,10 @@ def test_an_unknown_name_keeps_only_itself(parser, text) -> None:
 
 def test_a_dash_after_a_dotted_abbreviation_still_parts_clauses(parser) -> None:
     assert parser.parse("The t.v - go there now.").targets == ("tv",)  # a "tv_go"
+
+
+@pytest.mark.parametrize("where", ["in the 2nd bedroom", "in the kids' bedroom", "in mom's room", "in my son's room",
+                                   "in the kids' room", "in the girls' bedroom"])
+def test_someones_room_and_numbered_bedrooms(parser, where) -> None:
+    # "2nd_bedroom", "mom's_room": room labels no inference gives
+    assert parser.parse(f"find the bed {where}").relations == (("bed", "in", "bedroom"),)
