@@ -1053,75 +1053,16 @@ class OfflineParser:
     # ------------------------------------------------------------------ steps
     @staticmethod
     def _sentences(text: str) -> list[str]:
-        # accents are letters ("the sofá", "the café table"), not word breaks
-        text = "".join(c for c in unicodedata.normalize("NFKD", text) if not unicodedata.combining(c))
-        text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
-        for form, said in FIELDS:
-            text = form.sub(said, text)
-        text = re.sub(r"[\"“”()\[\]{}:]", " ", text)
-        text = PLACE_OF.sub("", WHERE_YOU_FIND.sub(". find ", text))
-        text = HAS_GOT.sub(" has", HEDGED_BE.sub(" ", text))
-        # "the chair & the table", "chair+sofa": and; "chair/sofa": or
-        text = re.sub(r"\s*[&+]\s*", " and ", re.sub(r"(?<=[a-z])/(?=[a-z])", " or ", text))
-        # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
-        # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
-        text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", " ; ", text)
-        text = re.sub(r"\bas well as\b", "and", text)
-        text = WHICHEVER.sub("", text)
-        # why the speaker asks names no object ("bring me to the tv so I can watch the news")
-        text = PURPOSE.sub("", text)
-        text = VIEWER_SIDE.sub("", text)
-        # what to do on arrival names no object: "go to the chair by the fridge and stop there";
-        # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
-        text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", THATS_IT.sub("", text)))
-        text = GOAL_PREDICATE.sub("", INSIST.sub(" ", text))
-        text = ON_ENTERING.sub(r" in \1", ON_THE_WALL.sub("", text))
-        text = CLOSER_THAN.sub(r"near \1", FAR_FROM.sub("", ITS_SIDE.sub("", HABIT.sub(" ", text))))
-        for first in (KIND_FIRST, NEGATED_FIRST):
-            m = first.match(text)
-            if m and re.search(r"\bthe one\b", text[m.end():]):
-                text = re.sub(r"\bthe one\b", "the " + m.group(1), text[m.end():], count=1)
-        text = ROBOT_OBJECT.sub("go to", text)
-        text = FINAL_COURTESY.sub("", text)
-        # a decimal point ends no sentence ("1.5 m from the fridge")
-        text = re.sub(r"(\d)\.(\d)", r"\1\2", text)
-        # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
-        text = re.sub(r"\b(?:[a-z]\.){2,}|\b(?:[a-z]\.)+[a-z]\b", lambda m: m.group(0).replace(".", "") + " ", text)
-        # the speaker corrects themself ("find the couch; no, the armchair", "go to the bed, oh
-        # wait, the sofa"): what follows the last correction is what is meant
-        fixes = list(CORRECTION.finditer(text))
-        if fixes:
-            text = text[fixes[-1].end():]
-        text = DONT.sub("", text)
+        """The instruction's clauses, lower case, each rewritten by the rules for people's ways
+        of asking (``_rewrite_text``, ``_rewrite_part``); clauses that only say how to get
+        there or to explore are dropped when another says what to find."""
         parts = re.split(r"[.!?;]+|,?\s+(?:and\s+)?then\s+|,\s+(?:and\s+|but\s+|so\s+)?(?=(?:(?:please|can you|could you|would you|now)\s+)*"
                          r"(?:find|look|go|search|locate|navigate|take|walk|head|bring|show|get|stop|wait|stand|"
                          r"approach|proceed|travel|move|turn|enter|exit|leave|follow|continue|keep)\b)"
                          r"|\s+and\s+(?=(?:find|look for|search for|locate|go|walk|head|stop|wait|stand|approach|"
                          r"proceed|travel|move|navigate|enter|check|make your way|take me|bring me|identify|spot|reach|"
-                         r"visit)\b)", text)
-        out = []
-        for part in parts:
-            part = re.sub(r"[^a-z0-9' \-,]", " ", part)
-            part = part.replace(",", " , ").replace("-", " ")
-            # who it is for names no object: "locate the coffee maker for me"
-            part = re.sub(r"\bfor (?:me|us|myself)\b", " ", part)
-            part = " ".join(part.split())
-            # how the speaker feels names no object ("I'm hungry, take me to the fridge"); what
-            # they want to do at an object names it ("I'd love to sit on the sofa")
-            part = SPEAKER_STATE.sub("", part).strip()
-            part = ACTIVITY.sub("go to ", part)
-            part = " ".join(WANTED.sub(" ", part).split())
-            part = STATE_CHECK.sub(r"go to \1", CONSUMABLE_FROM.sub("go to ", CHORE.sub("go to", part)))
-            needed = _need_object(part.replace(" ?", "").strip())
-            if needed is not None:
-                part = f"find the {needed}"
-            part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", LEAD_IN.sub("", part)))
-            part = HEDGE.sub("", MOTION_OVER.sub("go to", part)).strip()
-            part = WHERE_IT_IS.sub(r"\1", part)
-            part = PUT_THERE.sub(" ", WHOSE_PART.sub(" ", DISTANCE.sub(" near ", part)))
-            part = " ".join(re.sub(r"\brather than\b", "not", part).split())
-            if part:
-                out.append(part)
+                         r"visit)\b)", _rewrite_text(text))
+        out = [part for part in map(_rewrite_part, parts) if part]
         kept = [p for p in out if not ROUTE_STEP.match(p) and not EXPLORE_ONLY.fullmatch(p)]
         return kept or out
 
@@ -1432,6 +1373,79 @@ class OfflineParser:
 
 
 # ---------------------------------------------------------------------------- entry points
+
+def _rewrite_text(text: str) -> str:
+    """The whole instruction, lower case, with the rules that span clauses applied: accents,
+    field forms, symbols, dashes, what names no object at the ends (arrival, reports, courtesy,
+    purpose), the kind named first, dotted abbreviations, the speaker's last correction."""
+    # accents are letters ("the sofá", "the café table"), not word breaks
+    text = "".join(c for c in unicodedata.normalize("NFKD", text) if not unicodedata.combining(c))
+    text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
+    for form, said in FIELDS:
+        text = form.sub(said, text)
+    text = re.sub(r"[\"“”()\[\]{}:]", " ", text)
+    text = PLACE_OF.sub("", WHERE_YOU_FIND.sub(". find ", text))
+    text = HAS_GOT.sub(" has", HEDGED_BE.sub(" ", text))
+    # "the chair & the table", "chair+sofa": and; "chair/sofa": or
+    text = re.sub(r"\s*[&+]\s*", " and ", re.sub(r"(?<=[a-z])/(?=[a-z])", " or ", text))
+    # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
+    # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
+    text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", " ; ", text)
+    text = re.sub(r"\bas well as\b", "and", text)
+    text = WHICHEVER.sub("", text)
+    # why the speaker asks names no object ("bring me to the tv so I can watch the news")
+    text = PURPOSE.sub("", text)
+    text = VIEWER_SIDE.sub("", text)
+    # what to do on arrival names no object: "go to the chair by the fridge and stop there";
+    # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
+    text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", THATS_IT.sub("", text)))
+    text = GOAL_PREDICATE.sub("", INSIST.sub(" ", text))
+    text = ON_ENTERING.sub(r" in \1", ON_THE_WALL.sub("", text))
+    text = CLOSER_THAN.sub(r"near \1", FAR_FROM.sub("", ITS_SIDE.sub("", HABIT.sub(" ", text))))
+    for first in (KIND_FIRST, NEGATED_FIRST):
+        m = first.match(text)
+        if m and re.search(r"\bthe one\b", text[m.end():]):
+            text = re.sub(r"\bthe one\b", "the " + m.group(1), text[m.end():], count=1)
+    text = ROBOT_OBJECT.sub("go to", text)
+    text = FINAL_COURTESY.sub("", text)
+    # a decimal point ends no sentence ("1.5 m from the fridge")
+    text = re.sub(r"(\d)\.(\d)", r"\1\2", text)
+    # an abbreviation spelt with dots ("the t.v.", "the w.c.") is one word, not sentences
+    text = re.sub(r"\b(?:[a-z]\.){2,}|\b(?:[a-z]\.)+[a-z]\b", lambda m: m.group(0).replace(".", "") + " ", text)
+    # the speaker corrects themself ("find the couch; no, the armchair", "go to the bed, oh
+    # wait, the sofa"): what follows the last correction is what is meant
+    fixes = list(CORRECTION.finditer(text))
+    if fixes:
+        text = text[fixes[-1].end():]
+    text = DONT.sub("", text)
+    return text
+
+
+def _rewrite_part(part: str) -> str:
+    """One clause with the rules read at a clause's start applied: the speaker's state and
+    needs, chores, lead-ins, step markers, hedges, motions, distances; "" when nothing is left."""
+    part = re.sub(r"[^a-z0-9' \-,]", " ", part)
+    part = part.replace(",", " , ").replace("-", " ")
+    # who it is for names no object: "locate the coffee maker for me"
+    part = re.sub(r"\bfor (?:me|us|myself)\b", " ", part)
+    part = " ".join(part.split())
+    # how the speaker feels names no object ("I'm hungry, take me to the fridge"); what
+    # they want to do at an object names it ("I'd love to sit on the sofa")
+    part = SPEAKER_STATE.sub("", part).strip()
+    part = ACTIVITY.sub("go to ", part)
+    part = " ".join(WANTED.sub(" ", part).split())
+    part = STATE_CHECK.sub(r"go to \1", CONSUMABLE_FROM.sub("go to ", CHORE.sub("go to", part)))
+    needed = _need_object(part.replace(" ?", "").strip())
+    if needed is not None:
+        part = f"find the {needed}"
+    part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", LEAD_IN.sub("", part)))
+    part = HEDGE.sub("", MOTION_OVER.sub("go to", part)).strip()
+    part = WHERE_IT_IS.sub(r"\1", part)
+    part = PUT_THERE.sub(" ", WHOSE_PART.sub(" ", DISTANCE.sub(" near ", part)))
+    part = " ".join(re.sub(r"\brather than\b", "not", part).split())
+    return part
+
+
 def default_similarity() -> Similarity | None:
     """The MiniLM embedder's similarity (lazy), or None when perception is unavailable."""
     try:
