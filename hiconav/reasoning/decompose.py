@@ -374,7 +374,8 @@ AFTERWARDS = re.compile(
 LEAD_IN = re.compile(
     r"^(?:(?:if you (?:don't|do not) mind|when you (?:get|have) (?:a|the) (?:chance|moment|minute|second)|"
     r"whenever you can|if you can|if possible|when you can|at your convenience|when you're ready|"
-    r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh)\s*(?:,\s*|$)|"
+    r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh)"
+    r"(?:\s+(?:so|then|um|uh|now|well))*\s*(?:,\s*|$)|"
     r"(?:so\s+|um\s+|okay\s+|ok\s+)*(?:i was wondering if you could|i'd appreciate it if you could|"
     r"i would appreciate it if you could|would you mind|would you be so kind as to|do you know where|"
     r"i'd love it if you could|i would love it if you could|it would be great if you could|it'd be great if you could|"
@@ -403,8 +404,8 @@ STEP_MARKER = re.compile(r"^(?:step\s+\d+\s*,?\s*|(?:quick|quickly)\s+(?=the\b|a
                          r"hurry up)\s*(?:,\s*|$)|(?:finally|lastly|after that|afterwards)\s*,?\s*)")
 # a hedge about where it is names nothing ("I'm not sure where it is, but ..."); words that only
 # hedge open a clause ("Somewhere in this house there's a teddy bear")
-HEDGE = re.compile(r"^(?:i'm|i am|we're|we are)\s+not\s+sure\s+(?:where|if|whether|which)\b.*$|"
-                   r"^(?:i|we)\s+(?:don't|do not)\s+know\s+(?:where|if|whether|which)\b.*$|^no idea\s+(?:where|if)\b.*$")
+HEDGE = re.compile(r"^(?:(?:i'm|i am|we're|we are)\s+not\s+sure|(?:i|we)\s+(?:don't|do not)\s+know|no idea)\s+"
+                   r"(?:where|if|whether|which)\b[^,]*(?:,\s*(?:but\s+|though\s+|however\s+)?|$)")
 LEADING_HEDGE = re.compile(r"^(?:(?:somewhere|anywhere|maybe|perhaps|probably|possibly|usually|just|simply)\s+,?\s*)+")
 # how far it stands from another object ("the chair about two meters from the fridge", "a couple
 # of feet from"): near it; a distance no single view measures well enough to tell instances apart
@@ -454,9 +455,13 @@ ON_THE_WALL = re.compile(r"\s+(?:attached|fixed|fastened|mounted|screwed|bolted|
 ON_ENTERING = re.compile(r"\s+(?:as|when|once|after)\s+you\s+(?:enter|come in(?:to)?|walk in(?:to)?|go in(?:to)?|step into|"
                          r"get into)\s+((?:the|a)\s+[a-z' ]+?)(?=\s*(?:[,.;!?]|$))")
 # a correction at a clause's start, followed by what is meant (not "the one ...", which refines)
-CORRECTION = re.compile(r"(?:^|[.,;!?]\s*)(?:no|nope|actually|oh wait|wait|sorry|i mean|i meant|scratch that|make that|"
-                        r"correction|or rather)\s*,?\s+(?!the one\b|one\b)"
-                        r"(?=(?:find|go|take|locate|navigate|head|make|the|a|an|to|my)\b)")
+CORRECTION = re.compile(r"(?:^|[.,;!?]\s*)(?:(?:no|nope|actually|oh wait|wait|sorry|i mean|i meant|scratch that|make that|"
+                        r"correction|or rather|oh|hmm|er|um)\s*,?\s*)*(?:no|nope|actually|oh wait|wait|sorry|i mean|"
+                        r"i meant|scratch that|make that|correction|or rather)\s*,?\s+"
+                        r"(?=(?:find|go|take|locate|navigate|head|make|the|a|an|to|my|one)\b)")
+# the kind a corrected "the one ..." is of: the first object said with a relation before the correction
+KIND_BEFORE = re.compile(r"\b(?:the|a|an)\s+([a-z' ]+?)\s+(?:next to|near|by|beside|in|on|under|above|below|behind|"
+                         r"close to|opposite|facing|at|in front of)\b")
 # a request not to go somewhere, before the one that counts ("don't go to the sofa, go to ...")
 DONT = re.compile(r"^(?:please\s+)?(?:don't|do not|never)\s+(?:go to|find|take me to|look for|head to|walk to|navigate to)"
                   r"\b[^,.;!?]*[,.;!?]\s*(?:but\s+|instead\s+)?(?=\S)")
@@ -491,13 +496,19 @@ NEED_ASK = re.compile(
 
 
 def _need_object(part: str) -> str | None:
-    """The name of the object with which one does what the part asks to do, or None."""
+    """"find the <object>" (with where, if a room is said: "... in the living room") with which
+    one does what the part asks to do, or None."""
     m = NEED_ASK.match(part)
-    if m is None or (m.group("rest").strip() and not re.fullmatch(r"\s*(?:on|in|at|with|please|now|here)?\s*",
-                                                                  m.group("rest"))):
+    if m is None:
+        return None
+    rest = m.group("rest")
+    room = re.fullmatch(r"\s+(?:in|at)\s+(?:the|my|our)\s+[a-z' ]*\b(?:room|kitchen|bedroom|bathroom|hall|hallway|"
+                        r"lounge|office|study)", rest)
+    if room is None and rest.strip() and not re.fullmatch(r"\s*(?:on|in|at|with|please|now|here)?\s*", rest):
         return None  # "I want to sit on the sofa" names its object: ACTIVITY's rule
     need = m.group("need")
-    return next(name for pattern, name in NEEDS if re.fullmatch(pattern, need))
+    name = next(name for pattern, name in NEEDS if re.fullmatch(pattern, need))
+    return f"find the {name}" + (room.group(0) if room is not None else "")
 
 
 # written as fields ("Goal: chair. Location: kitchen, next to the fridge.", "landmark: fridge")
@@ -521,18 +532,18 @@ WHERE_YOU_FIND = re.compile(r",?\s+where\s+(?:you|one|we)\s+(?:should|will|can|c
 # tv; "look under the bed" a "look"; "take a seat on the sofa" a chair on the sofa; "grab me a
 # drink from the fridge" a "me_drink"; "check if the stove is off" an "if_stove_off")
 CHORE = re.compile(
-    r"^(?:(?:please|go|go and|now)\s+)*(?:(?:water|turn on|turn off|switch on|switch off|open|close|shut|make|clean|"
+    r"^(?:(?:please|go|go and|now|can you|could you|would you|will you)\s+)*(?:(?:water|turn on|turn off|switch on|switch off|open|close|shut|make|clean|"
     r"empty|charge|tidy up|tidy|dust|start|unplug|plug in|wipe down|wipe|fix|fill up|fill|load|unload|check on|"
     r"use)(?=\s+(?:the|my|our|your|a|an|that|this)\b)(?!\s+your\s+way\b)|(?:sit|lie|lie down|lay down|sit down|take a seat|have a seat|"
     r"take a nap|have a nap)\s+(?:on|in|at|by|next to)|(?:look|check|search|vacuum|clean)\s+(?:under|behind|inside|"
     r"beneath|underneath|on top of|in)(?=\s+(?:the|my|our|your|a|an)\b))")
 CONSUMABLE_FROM = re.compile(
-    r"^(?:(?:please|go|go and)\s+)*(?:get|grab|fetch|bring)(?:\s+(?:me|us))?\s+(?:a|an|some|the|my)?\s*(?:cold\s+)?"
+    r"^(?:(?:please|go|go and|can you|could you|would you|will you)\s+)*(?:get|grab|fetch|bring)(?:\s+(?:me|us))?\s+(?:a|an|some|the|my)?\s*(?:cold\s+)?"
     r"(?:drink|snack|beer|soda|water|juice|milk|food|bite|something to drink|something to eat|something cold|ice)"
     r"\s+(?:from|out of)\s+")
-STATE_CHECK = re.compile(r"^(?:check|see|look|find out)\s+(?:if|whether|that)\s+((?:the|my|our)\s+[a-z' ]+?)\s+"
+STATE_CHECK = re.compile(r"^(?:(?:please|can you|could you|would you|will you|go|go and)\s+)*(?:check|see|look|find out)\s+(?:if|whether|that)\s+((?:the|my|our)\s+[a-z' ]+?)\s+"
                          r"(?:is|are)\s+(?:still\s+)?(?:on|off|open|closed|shut|clean|dirty|running|working|plugged in|"
-                         r"unplugged|empty|full|locked|unlocked|there)\b.*$")
+                         r"unplugged|empty|full|locked|unlocked|there)(?:\s+or\s+not|\s+already|\s+yet|\s+now)?\s*$")
 # "take me to where the bed is", "the place where the tv is": the object
 WHERE_IT_IS = re.compile(r"\b(?:the (?:place|spot|room|area)\s+)?where\s+((?:the|a|an|my|your|our)\s+[a-z' ]+?)\s+(?:is|are)\b")
 # a step of the way that names no object to find ("turn left and find the plant", "go down the
@@ -1416,7 +1427,16 @@ def _rewrite_text(text: str) -> str:
     # wait, the sofa"): what follows the last correction is what is meant
     fixes = list(CORRECTION.finditer(text))
     if fixes:
-        text = text[fixes[-1].end():]
+        fixed = text[fixes[-1].end():]
+        if re.match(r"(?:the )?one\b", fixed):
+            # "find the chair next to the fridge; no wait, the one next to the sink": the kind
+            # stays, what singles it out is replaced; "find a chair, no, the one by the fridge"
+            # (no relation before) refines and keeps the text
+            kind = KIND_BEFORE.search(text[:fixes[-1].start()])
+            if kind is not None:
+                text = "find the " + kind.group(1) + re.sub(r"^(?:the )?one\b", "", fixed)
+        else:
+            text = fixed
     text = DONT.sub("", text)
     return text
 
@@ -1432,13 +1452,13 @@ def _rewrite_part(part: str) -> str:
     # how the speaker feels names no object ("I'm hungry, take me to the fridge"); what
     # they want to do at an object names it ("I'd love to sit on the sofa")
     part = SPEAKER_STATE.sub("", part).strip()
+    part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", LEAD_IN.sub("", part)))
     part = ACTIVITY.sub("go to ", part)
     part = " ".join(WANTED.sub(" ", part).split())
     part = STATE_CHECK.sub(r"go to \1", CONSUMABLE_FROM.sub("go to ", CHORE.sub("go to", part)))
     needed = _need_object(part.replace(" ?", "").strip())
     if needed is not None:
-        part = f"find the {needed}"
-    part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", LEAD_IN.sub("", part)))
+        part = needed
     part = HEDGE.sub("", MOTION_OVER.sub("go to", part)).strip()
     part = WHERE_IT_IS.sub(r"\1", part)
     part = PUT_THERE.sub(" ", WHOSE_PART.sub(" ", DISTANCE.sub(" near ", part)))

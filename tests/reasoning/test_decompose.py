@@ -1005,3 +1005,23 @@ def test_a_dash_after_a_dotted_abbreviation_still_parts_clauses(parser) -> None:
 def test_someones_room_and_numbered_bedrooms(parser, where) -> None:
     # "2nd_bedroom", "mom's_room": room labels no inference gives
     assert parser.parse(f"find the bed {where}").relations == (("bed", "in", "bedroom"),)
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # rules meeting in one request
+    ("Okay so, first head to the living room, then find the armchair beside the floor lamp and wait there.",
+     "armchair", (("armchair", "next to", "floor_lamp"), ("armchair", "in", "living_room"))),  # the living room an object
+    ("I'm not sure where it is, but there should be a laptop on the desk; take me to it.",
+     "laptop", (("laptop", "on", "desk"),)),  # no object found: the hedge took the whole clause
+    ("When you get a chance, could you check if the stove in the kitchen is off?",
+     "stove", (("stove", "in", "kitchen"),)),  # a room "kitchen_off"
+    ("Could you grab me a drink from the fridge in the kitchen?", "fridge", (("fridge", "in", "kitchen"),)),
+    ("I need somewhere to sit in the living room.", "chair", (("chair", "in", "living_room"),)),  # a "to"
+    ("Find the chair next to the fridge; no wait, the one next to the sink.",
+     "chair", (("chair", "next to", "sink"),)),  # both relations kept
+    ("Can you go see if the laptop is on the desk?", "laptop", (("laptop", "on", "desk"),)),  # "on" is no state here
+])
+def test_rules_meeting_in_one_request(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
