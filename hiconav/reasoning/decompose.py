@@ -368,18 +368,22 @@ FINAL_COMMAND = re.compile(
 AFTERWARDS = re.compile(
     r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?(?:let me know|tell me|report back|report|"
     r"come back|return|come back to me|return to me|wait for me|call me|ping me|notify me)"
-    r"(?:\s+(?:when|once|if)\s+[a-z' ]+)?(?:\s+please)?\s*[.!]*\s*$")
+    r"(?:\s+(?:when|once|if)\s+[a-z' ]+)?(?:\s+please)?\s*[.!?]*\s*$|"
+    r",\s*(?:can|could) you (?:go )?(?:check|confirm)(?: that| it| for me)?\s*[.!?]*\s*$")
 # words that lead in a request and name no object: "if you don't mind, ...", "when you get a
 # chance, ...", "your task: ...", "the robot should ...", "I was wondering if you could ..."
 LEAD_IN = re.compile(
     r"^(?:(?:if you (?:don't|do not) mind|when you (?:get|have) (?:a|the) (?:chance|moment|minute|second)|"
     r"whenever you can|if you can|if possible|when you can|at your convenience|when you're ready|"
-    r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh)"
+    r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh|please|i beg you|"
+    r"i'm begging you|i implore you|i ask you|i'm asking you)"
     r"(?:\s+(?:so|then|um|uh|now|well))*\s*(?:,\s*|$)|"
     r"(?:so\s+|um\s+|okay\s+|ok\s+)*(?:i was wondering if you could|i'd appreciate it if you could|"
     r"i would appreciate it if you could|would you mind|would you be so kind as to|do you know where|"
     r"i'd love it if you could|i would love it if you could|it would be great if you could|it'd be great if you could|"
     r"it would be nice if you could|i'd be grateful if you could|i would be grateful if you could|"
+    r"(?:(?:hey|hi|ok|okay|alright|right)\s+)?(?:robot\s*,?\s*)?(?:here's|here is|this is)\s+(?:your|the)\s+"
+    r"(?:task|mission|job)\s*,?|(?:hey|hi|ok|okay|alright)\s+robot\s*,|"
     r"can you tell me where|could you tell me where|let me know when you reach|let me know when you find|"
     r"it's time to|time to|basically|(?:the )?robot (?:should|must|needs to|has to|will|can)|"
     r"you need to|you have to|you must|you should|you are looking for|you're looking for|we are looking for|"
@@ -434,7 +438,7 @@ INSIST = re.compile(r"\b(?:make sure|be sure|ensure)\s+(?:that\s+)?(?=it|it's|it
 # what the speaker does with it: "the chair that I usually sit on", "the bed I sleep in": no
 # relation a view can check
 HABIT = re.compile(r"\s+(?:that\s+|which\s+)?(?:i|we|you|he|she|they|mom|dad)\s+(?:usually\s+|always\s+|often\s+|"
-                   r"normally\s+|sometimes\s+)?(?:sit on|sit in|sleep on|sleep in|use|like|love|prefer|work at|"
+                   r"normally\s+|sometimes\s+|can\s+|could\s+|would\s+|will\s+|might\s+)?(?:sit on|sit in|sleep on|sleep in|use|like|love|prefer|work at|"
                    r"eat at|read in|read on|watch|lie on|rest on|relax on|relax in)\b")
 # "far from the window" says where it is not; "closer to the fridge than to the table": near
 # the first
@@ -447,6 +451,10 @@ ITS_SIDE = re.compile(r"\s+(?:on|to)\s+(?:its|his|her|their)\s+(?:left|right)(?:
 # "..., that's what I want you to find": the speaker pointing back names nothing new
 THATS_IT = re.compile(r",?\s*that's\s+(?:what|the one|it)(?:\s+(?:i|we)\s+(?:want|need|mean|am looking for|'m looking for)"
                       r"(?:\s+you\s+to\s+(?:find|reach|go to|locate))?)?\s*[.!]*\s*$")
+# an aside on how sure the speaker is ("it's above the bed, I think, in the master bedroom", "I
+# believe the laptop is on the desk"): no object
+ASIDE = re.compile(r",?\s*\b(?:i think|i believe|i guess|i reckon|i suppose|if i remember correctly|if i recall "
+                   r"correctly|if i remember|if i recall|as far as i know|i'm pretty sure|i am pretty sure)\b\s*,?")
 # "the tv attached to the wall opposite the bed": the wall is no object, what follows is said of
 # the tv; "all the way at the end of the hallway": at its end
 ON_THE_WALL = re.compile(r"\s+(?:attached|fixed|fastened|mounted|screwed|bolted|pinned|stuck)\s+(?:to|on|onto)\s+"
@@ -567,7 +575,7 @@ WANTED = re.compile(
     r"(?:want|need|mean|seek|looking for|after|have in mind)(?:\s+to\s+(?:find|reach|see))?\s+is\s+"
     r"(?:the one\s+)?")
 # why the speaker asks, at the end: "bring me to the tv so I can watch the news"
-PURPOSE = re.compile(r",?\s+(?:so that|so|because|since|in order that)\s+(?:i|we|i'd|we'd|i'm|we're)\b[^.!?;]*")
+PURPOSE = re.compile(r",?\s+(?:so that|so|because|since|in order that)\s+(?:i|we|i'd|we'd|i'm|we're)\b[^.!?;,]*")
 FINAL_COURTESY = re.compile(
     r"(?:,?\s*\b(?:please|pls|plz|thanks|thank you|thanks a lot|thx|ty|cheers|asap|quickly|right away|"
     r"immediately|straight away|now|real quick|as (?:quickly|fast|soon) as (?:possible|you can)|when you can|"
@@ -670,7 +678,7 @@ FILLERS = frozenset([
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
     "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also", "whatever", "whichever",
-    "anywhere", "together", "actually", "currently", "hint", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
+    "anywhere", "together", "actually", "currently", "hint", "might", "may", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -1410,7 +1418,7 @@ def _rewrite_text(text: str) -> str:
     # what to do on arrival names no object: "go to the chair by the fridge and stop there";
     # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
     text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", THATS_IT.sub("", text)))
-    text = GOAL_PREDICATE.sub("", INSIST.sub(" ", text))
+    text = GOAL_PREDICATE.sub("", INSIST.sub(" ", ASIDE.sub(" ", text)))
     text = ON_ENTERING.sub(r" in \1", ON_THE_WALL.sub("", text))
     text = CLOSER_THAN.sub(r"near \1", FAR_FROM.sub("", ITS_SIDE.sub("", HABIT.sub(" ", text))))
     for first in (KIND_FIRST, NEGATED_FIRST):

@@ -1025,3 +1025,21 @@ def test_rules_meeting_in_one_request(parser, text, target, relations) -> None:
     task = parser.parse(text)
     assert task.targets == (target,)
     assert task.relations == relations
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    ("Alright robot, here's your task: go to the kitchen, locate the fridge, and stop in front of it.",
+     "fridge", (("fridge", "in", "kitchen"),)),  # a "to_kitchen"
+    ("Please, I beg you, find the toilet asap!!", "toilet", ()),  # a "beg_you"
+    ("Take me to the painting - it's above the bed, I think, in the bedroom.",
+     "painting", (("painting", "above", "bed"), ("bed", "in", "bedroom"), ("painting", "in", "bedroom"))),  # an "i_think"
+    ("I think the laptop is on the desk, can you check?", "laptop", (("laptop", "on", "desk"),)),  # a desk by "you_check"
+    ("Find a chair I can sit on next to the dining table.", "chair", (("chair", "next to", "dining_table"),)),  # an "i_can"
+    ("Take me to the couch so I can sit down, it's in the living room.", "sofa", (("sofa", "in", "living_room"),)),
+    ("So basically I lost my keys, they might be on the table next to the sofa. Go to that table.",
+     "dining_table", (("key_chain", "on", "dining_table"), ("dining_table", "next to", "sofa"))),  # a target "might"
+])
+def test_asides_and_requests_around_the_description(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert set(relations) <= set(task.relations)
