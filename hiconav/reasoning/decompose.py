@@ -562,6 +562,12 @@ ROUTE_STEP = re.compile(
     r"take the (?:stairs|elevator|lift|hallway|hall|corridor)|go straight|walk straight|go (?:up|down)stairs|"
     r"(?:go|walk|head|move|drive|continue|keep)\s+(?:down(?!\s+to\b)|along|through|past|across|up(?!\s+to\b)|"
     r"out of|out|back(?!\s+to\b)|straight|forward|ahead|around|on))\b")
+# how a clause asks: to go somewhere, or to find something
+GO_LEAD = re.compile(r"^(?:(?:please|now|then|and|first|can you|could you|would you)\s+)*(?:go to|go over to|navigate to|"
+                     r"head to|head over to|walk to|walk over to|take me to|bring me to|move to|proceed to|approach|go up to|"
+                     r"walk up to|get to|make your way to|travel to)\b")
+FIND_LEAD = re.compile(r"^(?:(?:please|now|then|and|can you|could you|would you)\s+)*(?:find|locate|look for|search for|"
+                       r"spot|identify|find me|look around for|search around for)\b")
 # a clause that only says to explore ("explore and find the chair", "look around the house")
 EXPLORE_ONLY = re.compile(r"(?:(?:please|now|first|just)\s+)*(?:explore|look around|search around|wander|wander around|"
                           r"roam|roam around|move around|walk around|go around|have a look around)"
@@ -903,8 +909,10 @@ class OfflineParser:
         attributes: dict[str, list[str]] = {}
         ahead: list[tuple[str, NounPhrase]] = []  # relations said before their object was named
 
+        went_to = False  # the target was named as where to go, not what to find
         for si, sentence in enumerate(sentences):
             words = sentence.split()
+            antecedent = targets[0].label if targets else None  # what "it" names in this sentence
             if targets and self._promote(words, targets, related, relations):
                 continue
             refers_to_target = bool(targets) and self._refers_to_target(words, targets)
@@ -945,6 +953,14 @@ class OfflineParser:
                 rooms += [p.room for p in room_only]
                 if not targets and objs:
                     targets += objs
+                    went_to = bool(GO_LEAD.match(sentence))
+                elif went_to and objs and FIND_LEAD.match(sentence) and objs[0].label != targets[0].label:
+                    # "go to the kitchen island and find the stool beside it": the object to
+                    # find is the target, the place gone to is related ("it" in this sentence)
+                    related.append(targets[0])
+                    targets[0] = objs[0]
+                    related += objs[1:]
+                    went_to = False
                 else:
                     related += objs
                 if not objs:
@@ -963,9 +979,10 @@ class OfflineParser:
                 # the phrase is parsed up to its negation (``_noun_phrase``); what follows is not
                 negated = any(w in NEGATIONS for w in np_words)
                 if np_words and all(w in PRONOUNS or w == "," for w in np_words):
-                    # "... in front of it": "it" is the target
-                    if targets and previous and previous[0].label != targets[0].label:
-                        relations.append((previous[0].label, relation, targets[0].label))
+                    # "... in front of it": "it" is the target (as it was when the sentence began)
+                    it = antecedent or (targets[0].label if targets else None)
+                    if it is not None and previous and previous[0].label != it:
+                        relations.append((previous[0].label, relation, it))
                     continue
                 phrases = self._noun_phrases(np_words)
                 for p in phrases:

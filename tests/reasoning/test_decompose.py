@@ -1043,3 +1043,17 @@ def test_asides_and_requests_around_the_description(parser, text, target, relati
     task = parser.parse(text)
     assert task.targets == (target,)
     assert set(relations) <= set(task.relations)
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # the place gone to first was the target, and "it" then named the object found
+    ("Navigate to the kitchen island and find the stool beside it.", "stool", (("stool", "next to", "counter_top"),)),
+    ("Go to the bed and find the pillow on it.", "pillow", (("pillow", "on", "bed"),)),
+    ("Go to the desk. Look for the laptop on it.", "laptop", (("laptop", "on", "desk"),)),
+    ("go to the kitchen and find the fridge", "fridge", (("fridge", "in", "kitchen"),)),  # a room is no target
+    ("Find the chair. It is next to the fridge.", "chair", (("chair", "next to", "fridge"),)),  # found first: stays
+])
+def test_what_to_find_after_where_to_go(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
