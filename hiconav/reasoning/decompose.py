@@ -314,7 +314,7 @@ DETERMINERS = frozenset([
 
 # words before "of" that pick from a kind ("a couple of plants"): the kind is the object
 # ("one of the chairs", "any of the beds": "one" and "any" are determiners, gone before "of" is read)
-PARTITIVES = frozenset(["either", "neither", "both", "all", "none", "couple", "few", "several", "pair",
+PARTITIVES = frozenset(["either", "neither", "both", "all", "none", "couple", "few", "several", "pair", "same", "different",
                         "nearest", "closest", "first", "last", "biggest", "largest", "smallest"])
 
 # Leading phrases to strip (longest first), repeated until none applies.
@@ -340,7 +340,8 @@ do we have|do you have|have we got|is there|are there|can you see|do you see|wha
 proceed to|proceed towards|travel to|make your way over to|make your way towards|hurry to|hurry over to|
 run to|rush to|go see|go check|wait by|wait at|wait next to|wait near|wait beside|wait in front of|
 stop next to|stop beside|stop in front of|stop close to|stand near|stand beside|stand in front of|stand at|
-fetch|grab|pick up|get me|bring|go back to|head back to|walk back to|come back to|return to|
+fetch|grab|pick up|get me|bring|go back to|head back to|walk back to|come back to|return to|take me back to|
+bring me back to|lead me back to|
 go down to|walk down to|head down to|head up to|
 take me|bring me|lead me|guide me to|escort me to|lead the way to|show me the way to|show me where|nav to|
 how do i get to|how can i get to|where do you keep|where would i find|where can i find|where do i find|
@@ -467,6 +468,15 @@ CORRECTION = re.compile(r"(?:^|[.,;!?]\s*)(?:(?:no|nope|actually|oh wait|wait|so
                         r"correction|or rather|oh|hmm|er|um)\s*,?\s*)*(?:no|nope|actually|oh wait|wait|sorry|i mean|"
                         r"i meant|scratch that|make that|correction|or rather)\s*,?\s+"
                         r"(?=(?:find|go|take|locate|navigate|head|make|the|a|an|to|my|one)\b)")
+# rooms said from where the robot stands ("the room you're in", "the next room", "the room across
+# the hall"), and objects by when they were seen ("the fridge you saw earlier", "the chair we
+# passed"): no room type and no relation a map can check
+EGO_ROOM = re.compile(r"\s+(?:in|inside|within)\s+(?:the\s+(?:next|other|adjacent|neighbouring|neighboring|same)\s+room|"
+                      r"the\s+room\s+(?:you're in|you are in|we're in|we are in|next door|across the hall|across from here|"
+                      r"(?:to|on) your (?:left|right)|behind you|ahead|in front of you|at the end of the hall(?:way)?))\b")
+SEEN_BEFORE = re.compile(r"\s+(?:that\s+|which\s+)?(?:you|we|i)\s+(?:saw|passed|have seen|'ve seen|noticed|found|walked past|"
+                         r"went past|came across|spotted|just saw|saw before)(?:\s+(?:earlier|before|just now|a moment ago|"
+                         r"on the way|already|a minute ago))?\b")
 # the kind a corrected "the one ..." is of: the first object said with a relation before the correction
 KIND_BEFORE = re.compile(r"\b(?:the|a|an)\s+([a-z' ]+?)\s+(?:next to|near|by|beside|in|on|under|above|below|behind|"
                          r"close to|opposite|facing|at|in front of)\b")
@@ -1436,6 +1446,7 @@ def _rewrite_text(text: str) -> str:
     # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
     text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", THATS_IT.sub("", text)))
     text = GOAL_PREDICATE.sub("", INSIST.sub(" ", ASIDE.sub(" ", text)))
+    text = SEEN_BEFORE.sub("", EGO_ROOM.sub("", text))
     text = ON_ENTERING.sub(r" in \1", ON_THE_WALL.sub("", text))
     text = CLOSER_THAN.sub(r"near \1", FAR_FROM.sub("", ITS_SIDE.sub("", HABIT.sub(" ", text))))
     for first in (KIND_FIRST, NEGATED_FIRST):

@@ -1057,3 +1057,21 @@ def test_what_to_find_after_where_to_go(parser, text, target, relations) -> None
     task = parser.parse(text)
     assert task.targets == (target,)
     assert task.relations == relations
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # rooms said from where the robot stands, objects by when they were seen: labels such as
+    # "room_you're", "next_room", "saw_earlier" no view confirms
+    ("Find the bed in the room you're in.", "bed", ()),
+    ("Find the tv in the next room.", "tv", ()),
+    ("Find the toilet in the room across the hall.", "toilet", ()),
+    ("Go to the bed in the room to your right.", "bed", ()),
+    ("Go to the fridge you saw earlier.", "fridge", ()),
+    ("Take me back to the chair we passed.", "chair", ()),
+    ("Find the same kind of chair in the bedroom.", "chair", (("chair", "in", "bedroom"),)),  # a "same"
+])
+def test_rooms_and_objects_said_from_the_robot(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert not task.attributes
