@@ -11,9 +11,8 @@ next to the fridge - go there"), the target called by another name, what to do o
 ("... and stop there"), the speaker's reason ("... so I can have a look, thanks"), steps of the
 way first ("Go down the hall, turn left and stop by ..."), who wants it ("The chair I want is the
 one next to the fridge."), the goal said as a predicate ("Explore and find it: the ... is my
-destination."), a typing slip ("the armhcair ..."). A parser that
-reads only the templates loses the description and stops at the first instance of the category
-it sees.
+destination."), a typing slip ("the armhcair ..."). A parser that reads only the templates
+loses the description and stops at the first instance of the category it sees.
 
 For each textnav instruction the script writes every form below that applies, decomposes the
 template and each form offline (``decompose_instruction``, MiniLM similarity) and counts a form as

@@ -105,8 +105,7 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("painting", "picture", "artwork", "poster", "framed picture", "portrait", "canvas", "photo", "photograph",
      "framed photo", "picture frame", "photo frame", "wall art", "print"): ("painting",),
     ("counter top", "countertop", "counter", "kitchen counter", "worktop", "kitchen island", "breakfast bar",
-     "kitchen bar", "island",
-     "island"): ("counter_top", "counter"),
+     "kitchen bar", "island"): ("counter_top", "counter"),
     ("floor lamp", "standing lamp", "lamp", "light", "floor light", "standard lamp", "torchiere", "uplighter", "uplight", "arc lamp"): ("floor_lamp", "lamp"),
     ("desk lamp", "small lamp", "table lamp", "reading lamp", "bedside lamp", "desk light", "study lamp", "bedside light",
      "table light", "task lamp", "task light", "bankers lamp"): ("desk_lamp", "lamp"),
@@ -393,10 +392,12 @@ LEAD_IN = re.compile(
 # "navigate the robot to the bed", "send the robot to ...", "navigate yourself to ...": go to
 ROBOT_OBJECT = re.compile(r"\b(?:navigate|move|send|drive|take|bring|get|steer|guide|direct|walk)\s+"
                           r"(?:the\s+|this\s+|our\s+|my\s+)?(?:robot|yourself|itself)\s+(?:over\s+)?to\b")
+# the end of a clause, looked ahead to
+_CLAUSE_END = r"(?=\s*(?:[,.;!?]|$))"
 # which one is meant by when it is met, or that any will do ("the first chair you see", "any
 # laptop will do"): no object, and nothing a map can check; only at a clause's end ("can you find")
 WHICHEVER = re.compile(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notice|encounter)(?:\s+first)?"
-                       r"(?=\s*(?:[.!?,;]|$))|\s+(?:will|would) do(?=\s*(?:[.!?,;]|$))")
+                       + _CLAUSE_END + r"|\s+(?:will|would) do" + _CLAUSE_END)
 # a side with nothing it is the side of ("the chair to the left") is the viewer's: no object, and
 # no relation a map can check
 VIEWER_SIDE = re.compile(r"\s+(?:to|on) the (?:left|right)(?:\s+(?:hand\s+)?side)?\b(?!\s+(?:of|side)\b)")
@@ -444,9 +445,9 @@ HABIT = re.compile(r"\s+(?:that\s+|which\s+)?(?:i|we|you|he|she|they|mom|dad)\s+
 # "far from the window" says where it is not; "closer to the fridge than to the table": near
 # the first
 FAR_FROM = re.compile(r"(?<!not)\s*,?\s+(?:but\s+|and\s+)?far\s+(?:away\s+)?from\s+(?:the|a|an)\s+[a-z' ]+?"
-                      r"(?=\s*(?:[,.;!?]|$))")
+                      + _CLAUSE_END)
 CLOSER_THAN = re.compile(r"\b(?:closer|nearer)\s+to\s+((?:the|a|an)\s+[a-z' ]+?)\s+than\s+(?:to\s+)?(?:the|a|an)\s+[a-z' ]+?"
-                         r"(?=\s*(?:[,.;!?]|$))")
+                         + _CLAUSE_END)
 # "a fridge on its left": a side of the object sought, already said by what it has
 ITS_SIDE = re.compile(r"\s+(?:on|to)\s+(?:its|his|her|their)\s+(?:left|right)(?:\s+(?:hand\s+)?side)?\b")
 # "..., that's what I want you to find": the speaker pointing back names nothing new
@@ -462,11 +463,10 @@ ON_THE_WALL = re.compile(r"\s+(?:attached|fixed|fastened|mounted|screwed|bolted|
                          r"the\s+wall\b|\s+all the way(?=\s)")
 # "to the left when you enter the kitchen": the room entered is the one it is in
 ON_ENTERING = re.compile(r"\s+(?:as|when|once|after)\s+you\s+(?:enter|come in(?:to)?|walk in(?:to)?|go in(?:to)?|step into|"
-                         r"get into)\s+((?:the|a)\s+[a-z' ]+?)(?=\s*(?:[,.;!?]|$))")
+                         r"get into)\s+((?:the|a)\s+[a-z' ]+?)" + _CLAUSE_END)
 # a correction at a clause's start, followed by what is meant (not "the one ...", which refines)
-CORRECTION = re.compile(r"(?:^|[.,;!?]\s*)(?:(?:no|nope|actually|oh wait|wait|sorry|i mean|i meant|scratch that|make that|"
-                        r"correction|or rather|oh|hmm|er|um)\s*,?\s*)*(?:no|nope|actually|oh wait|wait|sorry|i mean|"
-                        r"i meant|scratch that|make that|correction|or rather)\s*,?\s+"
+_CORRECTING = r"no|nope|actually|oh wait|wait|sorry|i mean|i meant|scratch that|make that|correction|or rather"
+CORRECTION = re.compile(rf"(?:^|[.,;!?]\s*)(?:(?:{_CORRECTING}|oh|hmm|er|um)\s*,?\s*)*(?:{_CORRECTING})\s*,?\s+"
                         r"(?=(?:find|go|take|locate|navigate|head|make|the|a|an|to|my|one)\b)")
 # rooms said from where the robot stands ("the room you're in", "the next room", "the room across
 # the hall"), and objects by when they were seen ("the fridge you saw earlier", "the chair we
@@ -549,17 +549,18 @@ WHERE_YOU_FIND = re.compile(r",?\s+where\s+(?:you|one|we)\s+(?:should|will|can|c
 # a chore done at an object is a request to go to it ("turn on the TV" sought a "turn" on the
 # tv; "look under the bed" a "look"; "take a seat on the sofa" a chair on the sofa; "grab me a
 # drink from the fridge" a "me_drink"; "check if the stove is off" an "if_stove_off")
+_ASKING = "please|go|go and|can you|could you|would you|will you"  # words before a chore or an errand
 CHORE = re.compile(
-    r"^(?:(?:please|go|go and|now|can you|could you|would you|will you)\s+)*(?:(?:water|turn on|turn off|switch on|switch off|open|close|shut|make|clean|"
+    rf"^(?:(?:{_ASKING}|now)\s+)*" r"(?:(?:water|turn on|turn off|switch on|switch off|open|close|shut|make|clean|"
     r"empty|charge|tidy up|tidy|dust|start|unplug|plug in|wipe down|wipe|fix|fill up|fill|load|unload|check on|"
     r"use)(?=\s+(?:the|my|our|your|a|an|that|this)\b)(?!\s+your\s+way\b)|(?:sit|lie|lie down|lay down|sit down|take a seat|have a seat|"
     r"take a nap|have a nap)\s+(?:on|in|at|by|next to)|(?:look|check|search|vacuum|clean)\s+(?:under|behind|inside|"
     r"beneath|underneath|on top of|in)(?=\s+(?:the|my|our|your|a|an)\b))")
 CONSUMABLE_FROM = re.compile(
-    r"^(?:(?:please|go|go and|can you|could you|would you|will you)\s+)*(?:get|grab|fetch|bring)(?:\s+(?:me|us))?\s+(?:a|an|some|the|my)?\s*(?:cold\s+)?"
+    rf"^(?:(?:{_ASKING})\s+)*" r"(?:get|grab|fetch|bring)(?:\s+(?:me|us))?\s+(?:a|an|some|the|my)?\s*(?:cold\s+)?"
     r"(?:drink|snack|beer|soda|water|juice|milk|food|bite|something to drink|something to eat|something cold|ice)"
     r"\s+(?:from|out of)\s+")
-STATE_CHECK = re.compile(r"^(?:(?:please|can you|could you|would you|will you|go|go and)\s+)*(?:check|see|look|find out)\s+(?:if|whether|that)\s+((?:the|my|our)\s+[a-z' ]+?)\s+"
+STATE_CHECK = re.compile(rf"^(?:(?:{_ASKING})\s+)*" r"(?:check|see|look|find out)\s+(?:if|whether|that)\s+((?:the|my|our)\s+[a-z' ]+?)\s+"
                          r"(?:is|are)\s+(?:still\s+)?(?:on|off|open|closed|shut|clean|dirty|running|working|plugged in|"
                          r"unplugged|empty|full|locked|unlocked|there)(?:\s+or\s+not|\s+already|\s+yet|\s+now)?\s*$")
 # "take me to where the bed is", "the place where the tv is": the object
@@ -858,13 +859,10 @@ class Lexicon:
         replaced by the one lexicon word it is a typing slip away from (``respelt``)."""
         return " ".join(respelt(w, self.words) for w in phrase.split())
 
-    @property
+    @functools.cached_property
     def words(self) -> frozenset[str]:
-        """Every word of the lexicon's phrases."""
-        cached = self.__dict__.get("_words")
-        if cached is None or cached[0] != len(self.phrases):
-            cached = self.__dict__["_words"] = (len(self.phrases), frozenset(w for p in self.phrases for w in p.split()))
-        return cached[1]
+        """Every word of the lexicon's phrases (``build`` fills the phrases before any use)."""
+        return frozenset(w for p in self.phrases for w in p.split())
 
     def lookup(self, phrase: str) -> str | None:
         phrase = " ".join(phrase.split())
@@ -1492,7 +1490,7 @@ def _rewrite_part(part: str) -> str:
     part = ACTIVITY.sub("go to ", part)
     part = " ".join(WANTED.sub(" ", part).split())
     part = STATE_CHECK.sub(r"go to \1", CONSUMABLE_FROM.sub("go to ", CHORE.sub("go to", part)))
-    needed = _need_object(part.replace(" ?", "").strip())
+    needed = _need_object(part.strip())
     if needed is not None:
         part = needed
     part = HEDGE.sub("", MOTION_OVER.sub("go to", part)).strip()
