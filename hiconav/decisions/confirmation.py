@@ -104,6 +104,21 @@ class Tally:
     fresh_by: tuple[tuple[int, int], ...] = ()
 
 
+def read_labels(anchor: Any, observed: set[int]) -> set[str]:
+    """The labels a frame read the candidate as: those of the detections it placed on the
+    ``observed`` supporting nodes; with none placed, or from a view that does not record which
+    label went where (``object_labels`` empty), every label the frame saw.
+
+    A look-alike beside a target (a sink by a toilet, an armchair by a sofa) is observed in the
+    same frames as the target, and read by every label of the frame it counted as read as the
+    target, so that the frames of a bathroom confirmed the sink."""
+    ids = tuple(getattr(anchor, "object_ids", ()))
+    per_object = tuple(getattr(anchor, "object_labels", ()))
+    if observed and len(per_object) == len(ids):
+        return {lab for i, labs in zip(ids, per_object) if int(i) in observed for lab in labs}
+    return set(getattr(anchor, "labels_seen", ()))
+
+
 def judge_frames(tally: Tally, frames: Sequence[Any], *, objects: Sequence[Any], grid: Any, center: np.ndarray,
                  box_min: np.ndarray, box_max: np.ndarray, support: set[int],
                  hiding: tuple[np.ndarray, np.ndarray] | None, targets: set[str], near: float) -> Tally:
@@ -135,7 +150,7 @@ def judge_frames(tally: Tally, frames: Sequence[Any], *, objects: Sequence[Any],
             in_view += 1
             for i in observed:
                 fresh_by[i] = fresh_by.get(i, 0) + 1
-            read = bool(targets.intersection(getattr(a, "labels_seen", ())))
+            read = bool(targets.intersection(read_labels(a, observed)))
             fresh_view = bool(observed) or (read and detected_too_near(a, box_min, box_max, labels, targets, near))
             fresh += int(fresh_view)
             reads += int(fresh_view and read)
@@ -256,5 +271,5 @@ def restart_unseen(tally: Tally) -> Tally:
 
 
 __all__ = ["Tally", "Verdict", "confirmed_node", "deferred", "detected_too_near", "evidence_verdict", "for_good",
-           "frames_since", "judge_frames", "label_verdict", "restart_unseen", "same_object", "support_confidence",
+           "frames_since", "judge_frames", "label_verdict", "read_labels", "restart_unseen", "same_object", "support_confidence",
            "support_ids", "support_observations", "target_labels", "timeout_verdict"]

@@ -12,6 +12,7 @@ decide pruning (that is ``graph.py`` with ``setcover.py``).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import cv2
@@ -121,7 +122,8 @@ def image_quality(image: np.ndarray) -> float:
 class Anchor:
     """Mutable anchor record owned by the graph (``view()`` gives the frozen AnchorView).
 
-    boxes maps object id -> (4,) normalised xyxy; labels_seen keeps first-seen order.
+    boxes maps object id -> (4,) normalised xyxy; box_labels object id -> the labels of the
+    detections placed on it; labels_seen keeps first-seen order.
     """
 
     id: int
@@ -134,6 +136,7 @@ class Anchor:
     descriptor: np.ndarray
     quality: float
     boxes: dict[int, np.ndarray] = field(default_factory=dict)
+    box_labels: dict[int, tuple[str, ...]] = field(default_factory=dict)
     far_labels: tuple[str, ...] = ()  # labels seen only beyond max_depth / without 3D
     _view: AnchorView | None = None
 
@@ -144,9 +147,12 @@ class Anchor:
                       frame.intrinsics, float(frame.stamp), freeze(image), labels_seen,
                       freeze(np.asarray(descriptor, dtype=np.float32)), float(quality))
 
-    def add_box(self, object_id: int, box: np.ndarray) -> None:
-        """Edge (a_i, o_j) with its 2D box; a second box for the same object becomes the union."""
+    def add_box(self, object_id: int, box: np.ndarray, labels: Iterable[str] = ()) -> None:
+        """Edge (a_i, o_j) with its 2D box and the ``labels`` of the detections placed on it; a
+        second box for the same object becomes the union."""
         box = np.asarray(box, dtype=np.float32)
+        held = self.box_labels.get(object_id, ())
+        self.box_labels[object_id] = held + tuple(lab for lab in labels if lab not in held)
         old = self.boxes.get(object_id)
         if old is not None:
             box = np.concatenate([np.minimum(old[:2], box[:2]), np.maximum(old[2:], box[2:])])
@@ -156,8 +162,9 @@ class Anchor:
     def replace_object(self, old_id: int, new_id: int) -> None:
         """Rewire the edge of a merged-away object ``old_id`` to ``new_id``."""
         box = self.boxes.pop(old_id, None)
+        labels = self.box_labels.pop(old_id, ())
         if box is not None:
-            self.add_box(new_id, box)
+            self.add_box(new_id, box, labels)
         self._view = None
 
     def view(self) -> AnchorView:
@@ -168,5 +175,6 @@ class Anchor:
                      else np.zeros((0, 4), dtype=np.float32))
             self._view = AnchorView(self.id, self.base_pose, self.T_world_cam, self.intrinsics,
                                     self.stamp, self.image, ids, freeze(boxes), self.labels_seen,
-                                    self.descriptor, self.quality)
+                                    self.descriptor, self.quality,
+                                    tuple(self.box_labels.get(i, ()) for i in ids))
         return self._view

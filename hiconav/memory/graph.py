@@ -246,7 +246,7 @@ class CognitiveMemoryGraph:
                 node.anchor_ids.add(anchor.id)  # bipartite edge (a_i, o_j)
                 node.observed_by.add(anchor.id)
                 node.touch()
-                anchor.add_box(j, obs.box_norm)
+                anchor.add_box(j, obs.box_norm, (obs.label,))
                 touched.append(j)
             if cfg.merge_nodes:
                 merged = self._merge_nodes(touched)

@@ -69,7 +69,9 @@ class AnchorView:
     object nodes it observes; boxes: (n, 4) float32 normalised [0, 1] xyxy, row j for
     object_ids[j]; labels_seen: every label detected in the image, including detections beyond
     the mapping depth (out-of-boundary evidence); descriptor: (D,) float32 unit mean of the
-    label features of labels_seen ((0,) when no label was seen); quality: image quality in [0, 1].
+    label features of labels_seen ((0,) when no label was seen); quality: image quality in [0, 1];
+    object_labels: row j the labels of the detections this image placed on object_ids[j] (empty
+    for views built without them).
     """
 
     id: int
@@ -83,6 +85,7 @@ class AnchorView:
     labels_seen: tuple[str, ...]
     descriptor: np.ndarray = field(default_factory=lambda: _EMPTY_F32, repr=False, compare=False)
     quality: float = 1.0
+    object_labels: tuple[tuple[str, ...], ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("T_world_cam", "image", "boxes", "descriptor"):

@@ -38,6 +38,7 @@ class Anchor:
     object_ids: tuple = ()
     labels_seen: tuple = ()
     intrinsics: CameraIntrinsics = CameraIntrinsics.from_hfov(640, 480, 79.0)
+    object_labels: tuple = ()  # row j: the labels placed on object_ids[j] (empty: not recorded)
 
 
 @dataclass

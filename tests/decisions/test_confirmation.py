@@ -73,6 +73,18 @@ def test_a_frame_that_observed_a_supporting_node_is_a_fresh_view():
     assert tally.fresh_by == ((1, 1),)
 
 
+def test_a_frame_reads_the_candidate_by_the_label_it_placed_on_it_not_by_its_neighbours():
+    objects = [node(1, "bed", 5.0, 5.0), node(2, "sofa", 5.0, 6.2)]
+    beside = Anchor(1, facing_bed(1).T_world_cam, (1, 2), ("sofa", "bed"), object_labels=(("sofa",), ("bed",)))
+    assert conf.read_labels(beside, {1}) == {"sofa"}
+    tally = judge([beside], objects, {1})
+    assert (tally.fresh, tally.target_reads) == (1, 0)
+    on_it = Anchor(2, facing_bed(1).T_world_cam, (1, 2), ("sofa", "bed"), object_labels=(("bed",), ("sofa",)))
+    assert (judge([on_it], objects, {1}).target_reads) == 1
+    # a view that does not record which label went where reads every label it saw
+    assert conf.read_labels(facing_bed(3, object_ids=(1,), labels_seen=("bed",)), {1}) == {"bed"}
+
+
 def test_a_frame_whose_camera_looks_away_is_unseen_not_a_miss():
     away = Anchor(1, camera_pose_from_base(Pose2D(3.5, 5.0, np.pi), 0.4))
     tally = judge([away], [node(1, "bed", 5.0, 5.0)], {1})

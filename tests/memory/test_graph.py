@@ -98,6 +98,8 @@ def test_graph_makes_a_requested_frame_an_anchor_that_records_what_it_saw(embedd
     assert seen.reason == missed.reason == "requested"
     anchors = {a.id: a for a in g.snapshot().anchors}
     assert anchors[seen.anchor_id].object_ids and not anchors[missed.anchor_id].object_ids
+    # and what it read each node as, row by row with object_ids (verification reads it)
+    assert anchors[seen.anchor_id].object_labels == (("chair",),) and anchors[missed.anchor_id].object_labels == ()
 
 
 def test_graph_gate_skips_frames_without_news(embedder):
@@ -194,6 +196,7 @@ def test_node_node_merge_when_views_come_to_overlap(embedder):
     assert len(snap.objects) == 1 and snap.objects[0].anchor_ids == (0, 1, 2)
     assert snap.objects[0].n_obs == 3
     assert all(snap.anchor(a).object_ids == (0,) for a in (0, 1, 2))  # edges rewired
+    assert all(snap.anchor(a).object_labels == (("sofa",),) for a in (0, 1, 2))  # with what was read
     assert float(snap.objects[0].size[1]) > 2.3
 
 
