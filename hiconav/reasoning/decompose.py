@@ -343,6 +343,8 @@ fetch|grab|pick up|get me|bring|go back to|head back to|walk back to|come back t
 bring me back to|lead me back to|
 go down to|walk down to|head down to|head up to|
 take me|bring me|lead me|guide me to|escort me to|lead the way to|show me the way to|show me where|nav to|
+take a look at|take a peek at|take a quick look at|have a peek at|have a quick look at|check out|inspect|
+possibly|kindly|pls|plz|goto|would it be possible to|is it possible to|would you mind|finding|locating|
 how do i get to|how can i get to|where do you keep|where would i find|where can i find|where do i find|
 i wanna see|i want to see|i'd like to see|i would like to see|i think there's|i think there is|i believe|
 explore until you find|explore until you see|keep exploring until you find|keep exploring until you see|
@@ -480,6 +482,14 @@ SEEN_BEFORE = re.compile(r"\s+(?:that\s+|which\s+)?(?:you|we|i)\s+(?:saw|passed|
 # the kind a corrected "the one ..." is of: the first object said with a relation before the correction
 KIND_BEFORE = re.compile(r"\b(?:the|a|an)\s+([a-z' ]+?)\s+(?:next to|near|by|beside|in|on|under|above|below|behind|"
                          r"close to|opposite|facing|at|in front of)\b")
+# how much the speaker prefers what follows: "a TV, preferably in the bedroom"
+PREFERENCE = re.compile(r"\b(?:preferably|ideally|if possible|if you can)\b")
+# how long to stay ("wait there for 5 minutes") and a device's state ("the lamp that is turned
+# on", "switched off") name no object
+DURATION_STATE = re.compile(r"\s*\bfor\s+(?:\d+|a|an|one|two|three|five|ten|a few|a couple of|few)\s+"
+                            r"(?:seconds?|secs?|minutes?|mins?|hours?)\b"
+                            r"|\s*\b(?:(?:that|which)\s+(?:is|are)\s+|that's\s+)?(?:turned|switched)\s+(?:on|off)\b")
+
 # a request not to go somewhere, before the one that counts ("don't go to the sofa, go to ...")
 DONT = re.compile(r"^(?:please\s+)?(?:don't|do not|never)\s+(?:go to|find|take me to|look for|head to|walk to|navigate to)"
                   r"\b[^,.;!?]*[,.;!?]\s*(?:but\s+|instead\s+)?(?=\S)")
@@ -1425,6 +1435,11 @@ def _rewrite_text(text: str) -> str:
     # accents are letters ("the sofá", "the café table"), not word breaks
     text = "".join(c for c in unicodedata.normalize("NFKD", text) if not unicodedata.combining(c))
     text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
+    # "a plant that isn't in the bathroom" says what it is not, as "is not" does
+    text = re.sub(r"\b(is|are|was|were)n't\b", r"\1 not", text)
+    # a preference ("a TV, preferably in the bedroom", "ideally the one by the window") is
+    # what is wanted: the words name no object
+    text = DURATION_STATE.sub("", PREFERENCE.sub("", text))
     for form, said in FIELDS:
         text = form.sub(said, text)
     text = re.sub(r"[\"“”()\[\]{}:]", " ", text)

@@ -1075,3 +1075,43 @@ def test_rooms_and_objects_said_from_the_robot(parser, text, target, relations) 
     assert task.targets == (target,)
     assert task.relations == relations
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # looking is the errand, not the object ("take a look at": a "take_look" sought)
+    ("Take a look at the painting above the bed.", "painting", (("painting", "above", "bed"),)),
+    ("Go take a look at the fridge.", "fridge", ()),
+    ("Take a peek at the tv in the living room.", "tv", (("tv", "in", "living_room"),)),
+    ("Check out the painting in the bedroom.", "painting", (("painting", "in", "bedroom"),)),
+    ("Inspect the painting above the bed.", "painting", (("painting", "above", "bed"),)),
+    # "isn't" says what it is not, as "is not" does (a "plant_isn't" sought)
+    ("Find a plant that isn't in the bathroom.", "plant", ()),
+    ("Find the chair which isn't next to the table.", "chair", ()),
+    # a preference is what is wanted ("preferably" was a second target)
+    ("Go find a TV, preferably in the bedroom.", "tv", (("tv", "in", "bedroom"),)),
+    ("Find a TV, ideally the one in the bedroom.", "tv", (("tv", "in", "bedroom"),)),
+    ("Find a sofa, preferably one near the window.", "sofa", (("sofa", "near", "window"),)),
+    # how long to stay and a device's state name no object ("for_minute", "turned" related)
+    ("Go to the bed and wait there for 5 minutes.", "bed", ()),
+    ("Find the lamp that is turned on.", "floor_lamp", ()),
+])
+def test_errands_negations_preferences_and_states_around_the_object(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert not any("minute" in r or r == "turned" for r in task.related)
+
+
+@pytest.mark.parametrize("text,target", [
+    ("Could you possibly navigate to the bed?", "bed"),
+    ("Would it be possible to find the fridge?", "fridge"),
+    ("Is it possible to go to the sofa?", "sofa"),
+    ("Would you mind finding the toilet?", "toilet"),
+    ("pls go 2 the fridge", "fridge"),
+    ("goto kitchen sink", "sink"),
+    ("Kindly proceed to the bathtub.", "bathtub"),
+])
+def test_polite_and_hasty_lead_ins_leave_no_words_on_the_target(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert not task.attributes  # the VLM's prompt read "the possibly navigate to bed"
