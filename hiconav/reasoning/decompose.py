@@ -484,6 +484,11 @@ KIND_BEFORE = re.compile(r"\b(?:the|a|an)\s+([a-z' ]+?)\s+(?:next to|near|by|bes
                          r"close to|opposite|facing|at|in front of)\b")
 # how much the speaker prefers what follows: "a TV, preferably in the bedroom"
 PREFERENCE = re.compile(r"\b(?:preferably|ideally|if possible|if you can)\b")
+# "it's the tall white thing in the kitchen": a word for any object, said of the target, is "one"
+GENERIC_THING = re.compile(r"\b((?:it's|it is|that's|that is|this is)\s+(?:the|a|an)\s+(?:[a-z]+\s+){0,3}?)"
+                           r"(?:thing|object|item)\b")
+# "neither in the kitchen nor in the living room" says where it is not, twice
+NEITHER_NOR = re.compile(r"\bneither\b(.{1,60}?)\bnor\b")
 # how long to stay ("wait there for 5 minutes") and a device's state ("the lamp that is turned
 # on", "switched off") name no object
 DURATION_STATE = re.compile(r"\s*\bfor\s+(?:\d+|a|an|one|two|three|five|ten|a few|a couple of|few)\s+"
@@ -706,6 +711,9 @@ FILLERS = frozenset([
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
     "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also", "whatever", "whichever",
     "anywhere", "together", "actually", "currently", "hint", "might", "may", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
+    # how sure the speaker is ("the chair kinda near the table", "maybe next to the fridge")
+    "kinda", "sorta", "maybe", "perhaps", "likely", "roughly", "approximately", "presumably", "supposedly",
+    "apparently", "possibly", "hopefully", "definitely",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
 VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
@@ -1440,6 +1448,7 @@ def _rewrite_text(text: str) -> str:
     # a preference ("a TV, preferably in the bedroom", "ideally the one by the window") is
     # what is wanted: the words name no object
     text = DURATION_STATE.sub("", PREFERENCE.sub("", text))
+    text = NEITHER_NOR.sub(r"not\1and not", GENERIC_THING.sub(r"\1one", text))
     for form, said in FIELDS:
         text = form.sub(said, text)
     text = re.sub(r"[\"“”()\[\]{}:]", " ", text)
@@ -1484,6 +1493,8 @@ def _rewrite_text(text: str) -> str:
             kind = KIND_BEFORE.search(text[:fixes[-1].start()])
             if kind is not None:
                 text = "find the " + kind.group(1) + re.sub(r"^(?:the )?one\b", "", fixed)
+            else:  # the correcting words go ("find the bed. i mean the one near the window")
+                text = text[:fixes[-1].start()] + ". " + fixed
         else:
             text = fixed
     text = DONT.sub("", text)

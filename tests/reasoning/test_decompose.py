@@ -1115,3 +1115,24 @@ def test_polite_and_hasty_lead_ins_leave_no_words_on_the_target(parser, text, ta
     task = parser.parse(text)
     assert task.targets == (target,)
     assert not task.attributes  # the VLM's prompt read "the possibly navigate to bed"
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # how sure the speaker is ("a chair_kinda", "a chair_maybe" sought)
+    ("Find the chair kinda near the table.", "chair", (("chair", "near", "dining_table"),)),
+    ("Find the chair maybe next to the fridge.", "chair", (("chair", "next to", "fridge"),)),
+    ("Find the plant that's likely in the living room.", "plant", (("plant", "in", "living_room"),)),
+    ("Find the plant, perhaps in the living room.", "plant", (("plant", "in", "living_room"),)),
+    # "neither ... nor" says where it is not (the chair was sought in both rooms)
+    ("Find the chair that is neither in the kitchen nor in the living room.", "chair", ()),
+    # "I mean" before what singles it out, with no relation before it (an "i_mean" near the window)
+    ("Find the bed. I mean the one near the window.", "bed", (("bed", "near", "window"),)),
+    ("There are two beds; I mean the one closer to the window.", "bed", (("bed", "near", "window"),)),
+    # a word for any object said of the target (a second target "thing")
+    ("Get me to the fridge, it's the tall white thing in the kitchen.", "fridge", (("fridge", "in", "kitchen"),)),
+    ("Find the lamp, it's the small thing on the desk.", "desk_lamp", (("desk_lamp", "on", "desk"),)),
+])
+def test_hedges_double_negations_and_what_the_speaker_means(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
