@@ -107,7 +107,7 @@ _SYNONYMS: dict[tuple[str, ...], tuple[str, ...]] = {
     ("counter top", "countertop", "counter", "kitchen counter", "worktop", "kitchen island", "breakfast bar",
      "kitchen bar", "island"): ("counter_top", "counter"),
     ("floor lamp", "standing lamp", "lamp", "light", "floor light", "standard lamp", "torchiere", "uplighter", "uplight", "arc lamp"): ("floor_lamp", "lamp"),
-    ("desk lamp", "small lamp", "table lamp", "reading lamp", "bedside lamp", "desk light", "study lamp", "bedside light",
+    ("desk lamp", "small lamp", "table lamp", "reading lamp", "bedside lamp", "nightstand lamp", "night stand lamp", "bedside table lamp", "desk light", "study lamp", "bedside light",
      "table light", "task lamp", "task light", "bankers lamp"): ("desk_lamp", "lamp"),
     ("coffee machine", "coffee maker", "espresso machine", "coffeemaker", "coffee brewer", "espresso maker", "percolator", "keurig", "nespresso"): ("coffee_machine",),
     ("washing machine", "washer", "laundry machine", "clothes washer", "washer machine", "front loader"): ("washing_machine",),
@@ -414,7 +414,7 @@ STEP_MARKER = re.compile(r"^(?:step\s+\d+\s*,?\s*|(?:quick|quickly)\s+(?=the\b|a
 # hedge open a clause ("Somewhere in this house there's a teddy bear")
 HEDGE = re.compile(r"^(?:(?:i'm|i am|we're|we are)\s+not\s+sure|(?:i|we)\s+(?:don't|do not)\s+know|no idea)\s+"
                    r"(?:where|if|whether|which)\b[^,]*(?:,\s*(?:but\s+|though\s+|however\s+)?|$)")
-LEADING_HEDGE = re.compile(r"^(?:(?:somewhere|anywhere|maybe|perhaps|probably|possibly|usually|just|simply)\s+,?\s*)+")
+LEADING_HEDGE = re.compile(r"^(?:(?:(?:somewhere|anywhere)(?!\s+(?:(?:where\s+)?(?:i|we)\s+can|to)\b)|maybe|perhaps|probably|possibly|usually|just|simply)\s+,?\s*)+")
 # how far it stands from another object ("the chair about two meters from the fridge", "a couple
 # of feet from"): near it; a distance no single view measures well enough to tell instances apart
 DISTANCE = re.compile(r"\s+(?:about|around|roughly|approximately|some|maybe|only|just)?\s*"
@@ -441,7 +441,8 @@ INSIST = re.compile(r"\b(?:make sure|be sure|ensure)\s+(?:that\s+)?(?=it|it's|it
                     r"particularly|especially|precisely|in particular|i\.e\.?|ie|you know)\b\s*,?")
 # what the speaker does with it: "the chair that I usually sit on", "the bed I sleep in": no
 # relation a view can check
-HABIT = re.compile(r"\s+(?:that\s+|which\s+)?(?:i|we|you|he|she|they|mom|dad)\s+(?:usually\s+|always\s+|often\s+|"
+HABIT = re.compile(r"(?<!something)(?<!somewhere)(?<!anything)(?<!anywhere)(?<!place)(?<!spot)"
+                   r"\s+(?:that\s+|which\s+)?(?:i|we|you|he|she|they|mom|dad)\s+(?:usually\s+|always\s+|often\s+|"
                    r"normally\s+|sometimes\s+|can\s+|could\s+|would\s+|will\s+|might\s+)?(?:sit on|sit in|sleep on|sleep in|use|like|love|prefer|work at|"
                    r"eat at|read in|read on|watch|lie on|rest on|relax on|relax in)\b")
 # "far from the window" says where it is not; "closer to the fridge than to the table": near
@@ -503,9 +504,13 @@ DONT = re.compile(r"^(?:please\s+)?(?:don't|do not|never)\s+(?:go to|find|take m
 NEEDS: tuple[tuple[str, str], ...] = (
     (r"sit(?: down)?", "chair"), (r"sleep|lie down|lay down|take a nap|have a nap|nap", "bed"),
     (r"relax|rest|lounge|chill out|put my feet up", "sofa"),
-    (r"wash (?:my |our |your )?hands|wash up|brush (?:my |our )?teeth|wash (?:my |our )?face", "sink"),
+    (r"wash (?:my |our |your )?hands|wash up|brush (?:my |our )?teeth|wash (?:my |our )?face|"
+     r"wash (?:the |some |my |our )?dishes|do (?:the )?dishes", "sink"),
+    (r"(?:store|keep|put away|fold) (?:my |our |the )?clothes", "dresser"),
+    (r"(?:put|set) (?:my |our |the )?laptop(?: down)?", "desk"),
+    (r"(?:the |a )?(?:bathroom|restroom|washroom|lavatory|loo)", "toilet"),
     (r"cook|fry|boil (?:some )?(?:water|eggs|pasta)", "stove"),
-    (r"watch (?:tv|television|the news|a movie|a film|a show|the game)", "tv"),
+    (r"watch (?:some |the )?(?:tv|television)|watch (?:tv|television|the news|a movie|a film|a show|the game)", "tv"),
     (r"keep (?:the |my |our )?(?:food|milk|drinks) cold|get a cold drink|chill (?:my |the |a )?(?:drink|drinks|beer|wine)",
      "fridge"),
     (r"(?:heat|warm|reheat) (?:up )?(?:my |our |the |some )?(?:food|leftovers|lunch|dinner|meal)|reheat", "microwave"),
@@ -513,7 +518,8 @@ NEEDS: tuple[tuple[str, str], ...] = (
     (r"make (?:some )?toast|toast (?:some |my )?bread", "toaster"),
     (r"wash (?:my |our |the )?clothes|do (?:the |my |some )?laundry", "washing machine"),
     (r"dry (?:my |our |the )?clothes|dry (?:the |my )?laundry", "clothes dryer"),
-    (r"throw (?:this|it|something|that|the trash|the rubbish|the garbage|trash|rubbish|garbage)? ?away|"
+    (r"throw away (?:the |some |my )?(?:trash|rubbish|garbage)|"
+     r"throw (?:this|it|something|that|the trash|the rubbish|the garbage|trash|rubbish|garbage)? ?away|"
      r"dispose of (?:this|it|something)|get rid of (?:this|it|some trash)", "garbage can"),
     (r"put (?:my |our |the )?(?:dirty )?(?:clothes|laundry)", "laundry hamper"),
     (r"use the (?:toilet|bathroom|restroom|loo|lavatory)|pee|poop|go potty", "toilet"),
@@ -521,10 +527,12 @@ NEEDS: tuple[tuple[str, str], ...] = (
     (r"work|study|do (?:my |some )?homework|write", "desk"),
 )
 NEED_ASK = re.compile(
-    r"^(?:where (?:can|do|could|should|would|may) (?:i|we)|(?:find|show|get|take|bring|lead|guide)(?: me| us)?(?: to)?\s+"
+    r"^(?:where (?:can|do|could|should|would|may) (?:i|we)|(?:(?:i|we) (?:need|want|would like|'d like) you to )?"
+    r"(?:find|show|get|take|bring|lead|guide)(?: me| us)?(?: to)?\s+"
     r"(?:somewhere|something|a place|a spot|anywhere|a good (?:place|spot))(?: (?:comfy|comfortable|nice|good|quiet|warm))?"
     r"(?: (?:where|so) (?:i|we) can| (?:i|we) can| to| for)?|(?:i|we) (?:need|want|would like|'d like|have) to|"
-    r"(?:i|we) (?:need|want) (?:somewhere|something|a place) to|(?:somewhere|something|a place) to)\s+"
+    r"(?:i|we) (?:need|want) (?:somewhere|something|a place) to|(?:somewhere|something|a place|a spot)"
+    r"(?: to| (?:where )?(?:i|we) can)|(?:i|we) (?:really )?(?:need|have to use|need to use))\s+"
     r"(?P<need>" + "|".join(f"(?:{need})" for need, _ in NEEDS) + r")\b(?P<rest>[a-z' ]*)$")
 
 
@@ -534,7 +542,7 @@ def _need_object(part: str) -> str | None:
     m = NEED_ASK.match(part)
     if m is None:
         return None
-    rest = m.group("rest")
+    rest = re.sub(r"^\s+and\s+[a-z']+(?:\s+[a-z']+)?$", "", m.group("rest"))  # "sit down and read"
     room = re.fullmatch(r"\s+(?:in|at)\s+(?:the|my|our)\s+[a-z' ]*\b(?:room|kitchen|bedroom|bathroom|hall|hallway|"
                         r"lounge|office|study)", rest)
     if room is None and rest.strip() and not re.fullmatch(r"\s*(?:on|in|at|with|please|now|here)?\s*", rest):
@@ -621,7 +629,12 @@ GOAL_PREDICATE = re.compile(
 # "I'm hungry, ...", "I am so tired": the speaker's state, before what they ask
 SPEAKER_STATE = re.compile(
     r"^(?:i'm|i am|we're|we are|i feel|i'm feeling|i am feeling)\s+(?:so |very |really |a bit |kind of )?"
-    r"(?:hungry|thirsty|tired|sleepy|cold|hot|bored|dirty|sweaty|exhausted|lost)(?:\s*,\s*|$)")
+    r"(?P<state>hungry|thirsty|tired|sleepy|cold|hot|bored|dirty|sweaty|exhausted|lost)(?:\s*,\s*|$)")
+# the robot called by name before the request
+ROBOT_CALLED = re.compile(r"^(?:(?:hey|hi|hello|ok|okay|yo)\s+)?robot\s*,?\s*")
+# where a speaker who says only how they feel wants to go
+STATE_NEEDS = {"hungry": "fridge", "thirsty": "fridge", "tired": "bed", "sleepy": "bed", "exhausted": "bed",
+               "bored": "tv"}
 # "I want to sit on the sofa", "let me lie down on the bed", "I'd like to wash my hands at the
 # sink": an activity at an object; the object is where to go
 ACTIVITY = re.compile(
@@ -1511,6 +1524,10 @@ def _rewrite_part(part: str) -> str:
     part = " ".join(part.split())
     # how the speaker feels names no object ("I'm hungry, take me to the fridge"); what
     # they want to do at an object names it ("I'd love to sit on the sofa")
+    part = ROBOT_CALLED.sub("", part)  # "Robot, I need you to find me a place to ..."
+    state = SPEAKER_STATE.fullmatch(part)
+    if state is not None and state.group("state") in STATE_NEEDS:
+        return f"find the {STATE_NEEDS[state.group('state')]}"  # all they say: "I'm thirsty."
     part = SPEAKER_STATE.sub("", part).strip()
     part = STEP_MARKER.sub("", LEADING_HEDGE.sub("", LEAD_IN.sub("", part)))
     part = ACTIVITY.sub("go to ", part)

@@ -1136,3 +1136,29 @@ def test_hedges_double_negations_and_what_the_speaker_means(parser, text, target
     task = parser.parse(text)
     assert task.targets == (target,)
     assert task.relations == relations
+
+
+@pytest.mark.parametrize("text,target", [
+    # what the speaker needs said as "a place / somewhere / something" to do it
+    ("Take me to something I can sleep on.", "bed"),  # the habit rule left a target "something"
+    ("Somewhere I can put my laptop down.", "desk"),  # the hedge rule left a "laptop_down"
+    ("Robot, I need you to find me a place to wash dishes.", "sink"),  # was the plates
+    ("Where can I store my clothes?", "dresser"),  # a "store_clothe"
+    ("Where could I sit down and read?", "chair"),  # an "i_down" and a "read"
+    ("Where do I throw away trash?", "garbage_can"),
+    ("I want to watch some TV.", "tv"),
+    # all the speaker says is how they feel or what room they need ("no object found")
+    ("I'm thirsty.", "fridge"),
+    ("I'm tired.", "bed"),
+    ("I need the restroom.", "toilet"),
+    ("Find the nightstand lamp.", "desk_lamp"),  # a floor lamp
+])
+def test_needs_said_as_a_place_or_a_feeling(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert not task.attributes and not task.relations
+
+
+def test_a_state_said_before_the_request_still_names_nothing(parser) -> None:
+    assert parser.parse("I'm hungry, take me to the fridge.").targets == ("fridge",)
+    assert parser.parse("I'm cold, find the bed.").targets == ("bed",)
