@@ -483,6 +483,13 @@ SEEN_BEFORE = re.compile(r"\s+(?:that\s+|which\s+)?(?:you|we|i)\s+(?:saw|passed|
 # the kind a corrected "the one ..." is of: the first object said with a relation before the correction
 KIND_BEFORE = re.compile(r"\b(?:the|a|an)\s+([a-z' ]+?)\s+(?:next to|near|by|beside|in|on|under|above|below|behind|"
                          r"close to|opposite|facing|at|in front of)\b")
+# ":)", ";-)", ":D", "=)", and pictographs
+EMOTICON = re.compile(r"(?:(?<=\s)|^)[:;=]-?[()\[\]dp]+(?=\s|$|[.!?])|[\u2600-\u27bf\U0001F300-\U0001FAFF]")
+# "Your mission, should you accept it: ..."
+MISSION_ASIDE = re.compile(r",?\s*should you (?:choose to |decide to )?accept it\s*[:,]?")
+# a condition at the end that names no place ("... if you look around", "if you search carefully")
+IF_YOU_LOOK = re.compile(r"\s*,?\s+if you (?:look|search|check|explore|go looking)(?:\s+(?:around|carefully|closely|"
+                         r"hard|well|in there|there|for it))?" + r"(?=\s*(?:[,.;!?]|$))")
 # how much the speaker prefers what follows: "a TV, preferably in the bedroom"
 PREFERENCE = re.compile(r"\b(?:preferably|ideally|if possible|if you can)\b")
 # "it's the tall white thing in the kitchen": a word for any object, said of the target, is "one"
@@ -1460,8 +1467,11 @@ def _rewrite_text(text: str) -> str:
     text = re.sub(r"\b(is|are|was|were)n't\b", r"\1 not", text)
     # a preference ("a TV, preferably in the bedroom", "ideally the one by the window") is
     # what is wanted: the words name no object
-    text = DURATION_STATE.sub("", PREFERENCE.sub("", text))
+    text = IF_YOU_LOOK.sub("", DURATION_STATE.sub("", PREFERENCE.sub("", text)))
     text = NEITHER_NOR.sub(r"not\1and not", GENERIC_THING.sub(r"\1one", text))
+    # emoticons are no field form ("the living room :)" read a field "room:") and no words
+    text = EMOTICON.sub(" ", text)
+    text = MISSION_ASIDE.sub(" ", text)
     for form, said in FIELDS:
         text = form.sub(said, text)
     text = re.sub(r"[\"“”()\[\]{}:]", " ", text)

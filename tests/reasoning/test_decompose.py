@@ -1162,3 +1162,15 @@ def test_needs_said_as_a_place_or_a_feeling(parser, text, target) -> None:
 def test_a_state_said_before_the_request_still_names_nothing(parser) -> None:
     assert parser.parse("I'm hungry, take me to the fridge.").targets == ("fridge",)
     assert parser.parse("I'm cold, find the bed.").targets == ("bed",)
+
+
+@pytest.mark.parametrize("text", [
+    "Go to the TV stand in the living room :)",  # "room :" read as a field: a room "living"
+    "Go to the TV stand in the living room 🙂",
+    "I think you'll find the TV stand in the living room if you look around.",  # in a "you_look"
+    "Your mission, should you accept it: find the TV stand in the living room.",  # a "mission"
+])
+def test_emoticons_conditions_and_asides_around_a_description(parser, text) -> None:
+    task = parser.parse(text)
+    assert task.targets == ("tv_stand",)
+    assert task.relations == (("tv_stand", "in", "living_room"),)
