@@ -343,6 +343,7 @@ fetch|grab|pick up|get me|bring|go back to|head back to|walk back to|come back t
 bring me back to|lead me back to|
 go down to|walk down to|head down to|head up to|
 take me|bring me|lead me|guide me to|escort me to|lead the way to|show me the way to|show me where|nav to|
+seek out|navigate toward|head toward|move toward|walk toward|go toward|where might i find|where could i find|
 take a look at|take a peek at|take a quick look at|have a peek at|have a quick look at|check out|inspect|
 possibly|kindly|pls|plz|goto|would it be possible to|is it possible to|would you mind|finding|locating|
 how do i get to|how can i get to|where do you keep|where would i find|where can i find|where do i find|
@@ -490,6 +491,9 @@ MISSION_ASIDE = re.compile(r",?\s*should you (?:choose to |decide to )?accept it
 # a condition at the end that names no place ("... if you look around", "if you search carefully")
 IF_YOU_LOOK = re.compile(r"\s*,?\s+if you (?:look|search|check|explore|go looking)(?:\s+(?:around|carefully|closely|"
                          r"hard|well|in there|there|for it))?" + r"(?=\s*(?:[,.;!?]|$))")
+# a last clause that only says to go where the description pointed ("...; head over there")
+GO_THERE = re.compile(r"(?:[.;,!]\s*|\s+(?:and|then|and then)\s+)(?:please\s+)?(?:head|go|walk|move|drive|navigate|get|come)"
+                      r"(?:\s+over)?\s+there(?:\s+(?:please|now))?\s*[.!]*\s*$")
 # how much the speaker prefers what follows: "a TV, preferably in the bedroom"
 PREFERENCE = re.compile(r"\b(?:preferably|ideally|if possible|if you can)\b")
 # "it's the tall white thing in the kitchen": a word for any object, said of the target, is "one"
@@ -631,7 +635,7 @@ FINAL_COURTESY = re.compile(
 # is where I want to go", "... is what I'm looking for")
 GOAL_PREDICATE = re.compile(
     r"\s+(?:is|will be)\s+(?:my|our|your|the)\s+(?:destination|goal|target|objective|aim)\b|"
-    r"\s+is\s+where\s+(?:i|we)\s+(?:want|need|'d like|would like)\s+(?:you\s+)?to\s+(?:go|be)\b|"
+    r"\s+is\s+where\s+(?:i|we)(?:\s+(?:want|need|would like)|\s*'d like)\s+(?:you\s+)?to\s+(?:go|be)\b|"
     r"\s+is\s+what\s+(?:i|we)(?:'m|\s+am|'re|\s+are)\s+(?:looking for|after)\b")
 # "I'm hungry, ...", "I am so tired": the speaker's state, before what they ask
 SPEAKER_STATE = re.compile(
@@ -1467,7 +1471,9 @@ def _rewrite_text(text: str) -> str:
     text = re.sub(r"\b(is|are|was|were)n't\b", r"\1 not", text)
     # a preference ("a TV, preferably in the bedroom", "ideally the one by the window") is
     # what is wanted: the words name no object
-    text = IF_YOU_LOOK.sub("", DURATION_STATE.sub("", PREFERENCE.sub("", text)))
+    text = GO_THERE.sub("", IF_YOU_LOOK.sub("", DURATION_STATE.sub("", PREFERENCE.sub("", text))))
+    # "the TV stand with the vase on top": on it (a counter top was read)
+    text = re.sub(r"\bon top\b(?!\s+of\b)", "on it", text)
     text = NEITHER_NOR.sub(r"not\1and not", GENERIC_THING.sub(r"\1one", text))
     # emoticons are no field form ("the living room :)" read a field "room:") and no words
     text = EMOTICON.sub(" ", text)

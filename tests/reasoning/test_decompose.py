@@ -1174,3 +1174,22 @@ def test_emoticons_conditions_and_asides_around_a_description(parser, text) -> N
     task = parser.parse(text)
     assert task.targets == ("tv_stand",)
     assert task.relations == (("tv_stand", "in", "living_room"),)
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # the goal as a predicate with "I'd like" ("vase on a to_go"); "on top" with no "of" is on it
+    ("The TV stand with the vase on top is where I'd like you to go.", "tv_stand",
+     (("tv_stand", "with", "vase"), ("vase", "on", "tv_stand"))),
+    # a last clause that only says to go there (a related "head")
+    ("There is a chair right beside the refrigerator; head over there.", "chair", (("chair", "next to", "fridge"),)),
+    # lead-ins that left words on the target ("out", "toward", "where i find")
+    ("Seek out the dresser.", "dresser", ()),
+    ("Navigate toward the painting that is in the vicinity of the vase.", "painting", (("painting", "near", "vase"),)),
+    ("Where might I find the TV in the living room?", "tv", (("tv", "in", "living_room"),)),
+])
+def test_paraphrased_descriptions(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert not task.attributes
+    assert "head" not in task.related
