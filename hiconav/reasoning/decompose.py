@@ -287,7 +287,7 @@ COLOURS = frozenset([
 ])
 MATERIALS = frozenset([
     "wooden", "wood", "metal", "metallic", "glass", "plastic", "leather", "fabric", "ceramic",
-    "marble", "stone", "steel", "iron", "porcelain", "wicker", "velvet", "cotton", "paper",
+    "marble", "stone", "steel", "stainless", "iron", "porcelain", "wicker", "velvet", "cotton", "paper",
     "cardboard", "rattan", "bamboo", "chrome", "brass", "copper", "woolen", "wool", "upholstered",
 ])
 SIZES = frozenset([
@@ -469,7 +469,8 @@ ON_THE_WALL = re.compile(r"\s+(?:attached|fixed|fastened|mounted|screwed|bolted|
 ON_ENTERING = re.compile(r"\s+(?:as|when|once|after)\s+you\s+(?:enter|come in(?:to)?|walk in(?:to)?|go in(?:to)?|step into|"
                          r"get into)\s+((?:the|a)\s+[a-z' ]+?)" + _CLAUSE_END)
 # a correction at a clause's start, followed by what is meant (not "the one ...", which refines)
-_CORRECTING = r"no|nope|actually|oh wait|wait|sorry|i mean|i meant|scratch that|make that|correction|or rather"
+_CORRECTING = (r"no|nope|actually|oh wait|wait|sorry|i mean|i meant|scratch that|make that|correction|or rather|"
+               r"not that one|not this one|not the one")
 CORRECTION = re.compile(rf"(?:^|[.,;!?]\s*)(?:(?:{_CORRECTING}|oh|hmm|er|um)\s*,?\s*)*(?:{_CORRECTING})\s*,?\s+"
                         r"(?=(?:find|go|take|locate|navigate|head|make|the|a|an|to|my|one)\b)")
 # rooms said from where the robot stands ("the room you're in", "the next room", "the room across
@@ -494,6 +495,17 @@ IF_YOU_LOOK = re.compile(r"\s*,?\s+if you (?:look|search|check|explore|go lookin
 # a last clause that only says to go where the description pointed ("...; head over there")
 GO_THERE = re.compile(r"(?:[.;,!]\s*|\s+(?:and|then|and then)\s+)(?:please\s+)?(?:head|go|walk|move|drive|navigate|get|come)"
                       r"(?:\s+over)?\s+there(?:\s+(?:please|now))?\s*[.!]*\s*$")
+# a place to keep out of, after the request ("find the bed, but avoid the kitchen")
+AVOID = re.compile(r"\s*,?\s*(?:but\s+|and\s+)?(?:please\s+)?(?:avoid|stay out of|keep out of|stay away from|"
+                   r"(?:don't|do not) (?:go|walk|drive) (?:into|in|through)|without going (?:into|in|through))\s+"
+                   r"(?:the|a|an|my|our)\s+[a-z' ]+?(?=\s*(?:[,.;!?]|$))")
+# "see if there's milk in the fridge": the fridge
+SEE_IF_THERE = re.compile(r"\b(?:see|check|look|find out)\s+(?:if|whether)\s+there(?:'s|\s+is|\s+are)\s+(?:any\s+|some\s+)?"
+                          r"[a-z' ]+?\s+(?:in|on|inside|at|by|near)\s+(?=(?:the|my|our)\b)"
+                          r"(?!(?:the|my|our)\s+(?:" + "|".join(sorted(map(re.escape, ROOMS), key=len, reverse=True))
+                          + r")\b)")  # "... a plant in the kitchen": the plant, in the kitchen
+# "the nearest chair to the window": the chair nearest to it (the window was read as the target)
+NEAREST_TO = re.compile(r"\b(nearest|closest)\s+([a-z]+(?:\s+[a-z]+)?)\s+to\s+(?=(?:the|a|an|my|our)\b)")
 # how much the speaker prefers what follows: "a TV, preferably in the bedroom"
 PREFERENCE = re.compile(r"\b(?:preferably|ideally|if possible|if you can)\b")
 # "it's the tall white thing in the kitchen": a word for any object, said of the target, is "one"
@@ -508,7 +520,8 @@ DURATION_STATE = re.compile(r"\s*\bfor\s+(?:\d+|a|an|one|two|three|five|ten|a fe
                             r"|\s*\b(?:(?:that|which)\s+(?:is|are)\s+|that's\s+)?(?:turned|switched)\s+(?:on|off)\b")
 
 # a request not to go somewhere, before the one that counts ("don't go to the sofa, go to ...")
-DONT = re.compile(r"^(?:please\s+)?(?:don't|do not|never)\s+(?:go to|find|take me to|look for|head to|walk to|navigate to)"
+DONT = re.compile(r"^(?:please\s+)?(?:don't|do not|never)\s+(?:go to|go into|go in|enter|find|take me to|look for|head to|"
+                  r"head into|walk to|walk into|navigate to)"
                   r"\b[^,.;!?]*[,.;!?]\s*(?:but\s+|instead\s+)?(?=\S)")
 # what the speaker needs to do, for the object one does it with ("where can I wash my hands?",
 # "find something to sit on", "I want to make coffee"): (need, the object's name)
@@ -611,6 +624,10 @@ ROUTE_STEP = re.compile(
 GO_LEAD = re.compile(r"^(?:(?:please|now|then|and|first|can you|could you|would you)\s+)*(?:go to|go over to|navigate to|"
                      r"head to|head over to|walk to|walk over to|take me to|bring me to|move to|proceed to|approach|go up to|"
                      r"walk up to|get to|make your way to|travel to)\b")
+# a sentence in which the speaker tells something before asking ("My phone is on the
+# nightstand.", "We just moved in.", "I dropped my earring near the bed")
+SPEAKER_STATEMENT = re.compile(r"^(?:(?:my|our|his|her|their|i|we|i've|we've)\s+(?!(?:want|need|would|'d|wanna)\b)|"
+                               r"there's\s|there is\s|there are\s)")
 FIND_LEAD = re.compile(r"^(?:(?:please|now|then|and|can you|could you|would you)\s+)*(?:find|locate|look for|search for|"
                        r"spot|identify|find me|look around for|search around for)\b")
 # a clause that only says to explore ("explore and find the chair", "look around the house")
@@ -960,6 +977,7 @@ class OfflineParser:
         ahead: list[tuple[str, NounPhrase]] = []  # relations said before their object was named
 
         went_to = False  # the target was named as where to go, not what to find
+        stated = False  # ... or in something the speaker told ("My phone is on the nightstand.")
         for si, sentence in enumerate(sentences):
             words = sentence.split()
             antecedent = targets[0].label if targets else None  # what "it" names in this sentence
@@ -1004,13 +1022,18 @@ class OfflineParser:
                 if not targets and objs:
                     targets += objs
                     went_to = bool(GO_LEAD.match(sentence))
-                elif went_to and objs and FIND_LEAD.match(sentence) and objs[0].label != targets[0].label:
+                    stated = bool(SPEAKER_STATEMENT.match(sentence)) and not went_to and not FIND_LEAD.match(sentence)
+                elif ((went_to and FIND_LEAD.match(sentence)) or (stated and (FIND_LEAD.match(sentence) or GO_LEAD.match(sentence)))) \
+                        and objs and objs[0].label != targets[0].label:
                     # "go to the kitchen island and find the stool beside it": the object to
-                    # find is the target, the place gone to is related ("it" in this sentence)
-                    related.append(targets[0])
+                    # find is the target, the place gone to is related ("it" in this sentence);
+                    # "My glasses are next to the laptop. Take me to the laptop.": what the
+                    # speaker told first is context, the object asked for is the target
+                    if targets[0].in_vocabulary:
+                        related.append(targets[0])
                     targets[0] = objs[0]
                     related += objs[1:]
-                    went_to = False
+                    went_to = stated = False
                 else:
                     related += objs
                 if not objs:
@@ -1472,6 +1495,7 @@ def _rewrite_text(text: str) -> str:
     # a preference ("a TV, preferably in the bedroom", "ideally the one by the window") is
     # what is wanted: the words name no object
     text = GO_THERE.sub("", IF_YOU_LOOK.sub("", DURATION_STATE.sub("", PREFERENCE.sub("", text))))
+    text = NEAREST_TO.sub(r"\2 \1 to ", SEE_IF_THERE.sub("go to ", AVOID.sub("", text)))
     # "the TV stand with the vase on top": on it (a counter top was read)
     text = re.sub(r"\bon top\b(?!\s+of\b)", "on it", text)
     text = NEITHER_NOR.sub(r"not\1and not", GENERIC_THING.sub(r"\1one", text))

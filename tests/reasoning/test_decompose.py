@@ -1193,3 +1193,32 @@ def test_paraphrased_descriptions(parser, text, target, relations) -> None:
     assert task.relations == relations
     assert not task.attributes
     assert "head" not in task.related
+
+
+@pytest.mark.parametrize("text,target", [
+    # what the speaker tells first is context; the object then asked for is the target
+    ("My glasses are next to the laptop. Take me to the laptop.", "laptop"),  # was a cup (glasses)
+    ("My phone is on the nightstand; please go to the nightstand.", "side_table"),  # the phone
+    ("We just moved in. Can you find where the fridge is?", "fridge"),  # a "we_moved"
+    ("There's a painting in the hallway. Find the chair under it.", "chair"),  # the painting
+    # ... but "it" and "that one" still name what was told of
+    ("There's a vase on the dining table. Bring me to it.", "vase"),
+    ("In the bedroom there is a TV. Find it.", "tv"),
+    # places to keep out of, and containers to look in
+    ("Find the bed, but avoid the kitchen.", "bed"),  # an "avoid_kitchen"
+    ("Don't go into the bathroom; find the plant.", "plant"),  # a toilet
+    ("Find the plant and stay out of the bedroom.", "plant"),
+    ("Can you go see if there's milk in the fridge?", "fridge"),  # a "there's_milk"
+    ("Find the nearest chair to the window.", "chair"),  # the window
+])
+def test_context_told_first_places_avoided_and_containers(parser, text, target) -> None:
+    assert parser.parse(text).targets == (target,)
+
+
+def test_not_that_one_keeps_what_singles_it_out_and_a_room_in_a_check_stays_a_room(parser) -> None:
+    task = parser.parse("Go to the chair. Not that one, the one near the window.")
+    assert task.targets == ("chair",) and task.relations == (("chair", "near", "window"),)
+    task = parser.parse("Check whether there's a plant in the kitchen.")
+    assert task.targets == ("plant",) and ("plant", "in", "kitchen") in task.relations
+    task = parser.parse("Find the nearest chair to the window.")
+    assert task.relations == (("chair", "near", "window"),)
