@@ -504,6 +504,10 @@ SEE_IF_THERE = re.compile(r"\b(?:see|check|look|find out)\s+(?:if|whether)\s+the
                           r"[a-z' ]+?\s+(?:in|on|inside|at|by|near)\s+(?=(?:the|my|our)\b)"
                           r"(?!(?:the|my|our)\s+(?:" + "|".join(sorted(map(re.escape, ROOMS), key=len, reverse=True))
                           + r")\b)")  # "... a plant in the kitchen": the plant, in the kitchen
+# "the bench at the end of the bed": beside it (at the end of a room is in it: "the plant at the
+# far end of the hallway")
+END_OF_OBJECT = re.compile(r"\bat the (?:far |other )?end of (?=(?:the|a|an|my|our)\s+(?!(?:"
+                           + "|".join(sorted(map(re.escape, ROOMS), key=len, reverse=True)) + r")\b))")
 # "the nearest chair to the window": the chair nearest to it (the window was read as the target)
 NEAREST_TO = re.compile(r"\b(nearest|closest)\s+([a-z]+(?:\s+[a-z]+)?)\s+to\s+(?=(?:the|a|an|my|our)\b)")
 # how much the speaker prefers what follows: "a TV, preferably in the bedroom"
@@ -717,12 +721,18 @@ RELATIONS: dict[str, str] = {
     "faces": "facing", "face": "facing", "facing towards": "facing", "facing toward": "facing",
     "pointed at": "facing", "pointing at": "facing", "pointing towards": "facing", "turned towards": "facing",
     "turned toward": "facing", "oriented towards": "facing", "angled towards": "facing",
+    "angled toward": "facing", "oriented toward": "facing", "pointed toward": "facing", "pointed towards": "facing",
+    "pointing toward": "facing", "angled at": "facing",
     "across the room from": "opposite", "on the other side of the room from": "opposite",
     "diagonally opposite": "near", "diagonally across from": "near", "diagonally from": "near",
     "diagonal to": "near", "diagonal from": "near", "kitty corner from": "near", "kitty corner to": "near",
     "catty corner from": "near", "catty corner to": "near",
     "within arm's reach of": "near", "within easy reach of": "near", "flanked by": "next to",
     "at the foot of": "next to", "at the head of": "next to", "on the same wall as": "near",
+    "on either side of": "next to", "on both sides of": "next to", "on each side of": "next to",
+    "either side of": "next to", "in line with": "near", "lined up with": "near", "aligned with": "near",
+    "centered over": "above", "centred over": "above", "centered above": "above", "centred above": "above",
+    "centered under": "under", "centred under": "under", "centered below": "below", "centred below": "below",
     "same wall as": "near", "in the same room as": "near",
     "tucked in at": "next to", "tucked in to": "next to", "tucked in under": "under", "pushed in at": "next to",
     "pushed in under": "under", "sandwiched between": "between", "squeezed between": "between",
@@ -751,7 +761,7 @@ FILLERS = frozenset([
     "probably", "mounted", "hangs", "hang", "stored", "leaning", "leans", "sat", "perched",
     "displayed", "installed", "be", "should", "must", "that's", "which's", "who's",
     "immediately", "straight", "exactly", "upstairs", "downstairs", "but", "also", "whatever", "whichever",
-    "anywhere", "together", "actually", "currently", "hint", "might", "may", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
+    "anywhere", "together", "actually", "currently", "hint", "flush", "might", "may", "sandwiched", "squeezed", "wedged", "nestled", "situated", "propped", "parked",
     # how sure the speaker is ("the chair kinda near the table", "maybe next to the fridge")
     "kinda", "sorta", "maybe", "perhaps", "likely", "roughly", "approximately", "presumably", "supposedly",
     "apparently", "possibly", "hopefully", "definitely",
@@ -1496,6 +1506,7 @@ def _rewrite_text(text: str) -> str:
     # what is wanted: the words name no object
     text = GO_THERE.sub("", IF_YOU_LOOK.sub("", DURATION_STATE.sub("", PREFERENCE.sub("", text))))
     text = NEAREST_TO.sub(r"\2 \1 to ", SEE_IF_THERE.sub("go to ", AVOID.sub("", text)))
+    text = END_OF_OBJECT.sub("next to ", text)
     # "the TV stand with the vase on top": on it (a counter top was read)
     text = re.sub(r"\bon top\b(?!\s+of\b)", "on it", text)
     text = NEITHER_NOR.sub(r"not\1and not", GENERIC_THING.sub(r"\1one", text))

@@ -1222,3 +1222,19 @@ def test_not_that_one_keeps_what_singles_it_out_and_a_room_in_a_check_stays_a_ro
     assert task.targets == ("plant",) and ("plant", "in", "kitchen") in task.relations
     task = parser.parse("Find the nearest chair to the window.")
     assert task.relations == (("chair", "near", "window"),)
+
+
+@pytest.mark.parametrize("text,relation", [
+    ("Find the bench at the end of the bed.", ("bench", "next to", "bed")),  # the relation was lost
+    ("Find the chair at the end of the dining table.", ("chair", "next to", "dining_table")),
+    ("Find the plant at the far end of the hallway.", ("plant", "in", "hallway")),  # a room's end: in it
+    ("Find the stool in line with the counter.", ("stool", "near", "counter_top")),  # in a "line"
+    ("Find the lamp on either side of the bed.", ("floor_lamp", "next to", "bed")),  # on an "either_side"
+    ("Find the plant that's flush with the wall next to the TV.", ("plant", "next to", "tv")),  # a "plant_flush"
+    ("Find the painting that's centered over the bed.", ("painting", "above", "bed")),  # a "painting_centered"
+    ("Find the chair that's angled toward the TV.", ("chair", "facing", "tv")),  # the TV was the target
+])
+def test_more_ways_of_saying_where_it_stands(parser, text, relation) -> None:
+    task = parser.parse(text)
+    assert task.targets == (relation[0],)
+    assert task.relations == (relation,)
