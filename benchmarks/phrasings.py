@@ -11,7 +11,10 @@ next to the fridge - go there"), the target called by another name, what to do o
 ("... and stop there"), the speaker's reason ("... so I can have a look, thanks"), steps of the
 way first ("Go down the hall, turn left and stop by ..."), who wants it ("The chair I want is the
 one next to the fridge."), the goal said as a predicate ("Explore and find it: the ... is my
-destination."), a typing slip ("the armhcair ..."). A parser that reads only the templates
+destination."), a typing slip ("the armhcair ..."), something told before the request ("My
+keys are somewhere around here. Take me to ..."), a look asked for politely ("Could you possibly
+take a look at ...? :)"), a hedge and a condition ("... that's kinda next to ..., if you look
+around"). A parser that reads only the templates
 loses the description and stops at the first instance of the category it sees.
 
 For each textnav instruction the script writes every form below that applies, decomposes the
@@ -100,6 +103,9 @@ def forms(instruction: str, target: str) -> dict[str, str]:
     out["route"] = f"Go down the hall, turn left and stop by the {name} {rest}"
     out["wanted"] = f"The {name} I want is the one {rest}."
     out["destination"] = f"Explore and find it: the {name} {rest} is my destination."
+    out["context"] = f"My keys are somewhere around here. Take me to the {name} {rest}."
+    out["look"] = f"Could you possibly take a look at the {name} {rest}? :)"
+    out["hedge"] = f"Find the {name} that's kinda {rest}, if you look around."
     slipped = slip(name)
     if slipped != name:
         out["slip"] = f"find the {slipped} {rest}"
