@@ -309,6 +309,7 @@ DETERMINERS = frozenset([
     "a", "an", "the", "some", "any", "my", "your", "our", "their", "his", "her", "its", "this",
     "that", "these", "those", "one", "another", "each", "every", "there", "here", "please", "kind",
     "sort", "type", "very", "really", "quite", "rather",
+    "teh", "th", "hte", "da", "tha",  # "the" mistyped or said casually ("find teh bed", "go to da couch")
 ])
 
 # words before "of" that pick from a kind ("a couple of plants"): the kind is the object

@@ -1238,3 +1238,9 @@ def test_more_ways_of_saying_where_it_stands(parser, text, relation) -> None:
     task = parser.parse(text)
     assert task.targets == (relation[0],)
     assert task.relations == (relation,)
+
+
+@pytest.mark.parametrize("text,target", [("find teh bed", "bed"), ("find th sofa", "sofa"), ("Go to da couch.", "sofa")])
+def test_a_mistyped_or_casual_article_is_no_attribute(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,) and not task.attributes
