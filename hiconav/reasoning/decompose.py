@@ -486,6 +486,12 @@ SEEN_BEFORE = re.compile(r"\s+(?:that\s+|which\s+)?(?:you|we|i)\s+(?:saw|passed|
 # the kind a corrected "the one ..." is of: the first object said with a relation before the correction
 KIND_BEFORE = re.compile(r"\b(?:the|a|an)\s+([a-z' ]+?)\s+(?:next to|near|by|beside|in|on|under|above|below|behind|"
                          r"close to|opposite|facing|at|in front of)\b")
+# what people write short ("the chair b/w the table and the window", "w/ the fridge next to it",
+# "nr the fridge", "@ kitchen", "go to kitchen -> find the chair")
+SHORTHAND = ((re.compile(r"\bb/w\b"), "between"), (re.compile(r"\bw/o\b"), "without"),
+             (re.compile(r"\bw/(?=\s|[a-z])"), "with "), (re.compile(r"\bnr\b"), "near"),
+             (re.compile(r"\bnxt\b"), "next"), (re.compile(r"\s*@\s*"), " at "),
+             (re.compile(r"\s*(?:-+>|=>|\u2192)\s*"), " ; "))
 # ":)", ";-)", ":D", "=)", and pictographs
 EMOTICON = re.compile(r"(?:(?<=\s)|^)[:;=]-?[()\[\]dp]+(?=\s|$|[.!?])|[\u2600-\u27bf\U0001F300-\U0001FAFF]")
 # "Your mission, should you accept it: ..."
@@ -582,10 +588,10 @@ def _need_object(part: str) -> str | None:
 
 
 # written as fields ("Goal: chair. Location: kitchen, next to the fridge.", "landmark: fridge")
-FIELDS = ((re.compile(r"\b(?:object|target|goal|item|destination)\s*:\s*"), "find the "),
-          (re.compile(r"\b(?:location|room|place|area)\s*:\s*"), "it is in the "),
-          (re.compile(r"\b(?:landmark|near|next to|reference)\s*:\s*"), "it is near the "),
-          (re.compile(r"\b(?:hint|note|tip|clue|fyi)\s*:\s*"), ""))
+FIELDS = ((re.compile(r"\b(?:object|target|goal|item|destination)\s*[:=]\s*"), "find the "),
+          (re.compile(r"\b(?:location|room|place|area)\s*[:=]\s*"), "it is in the "),
+          (re.compile(r"\b(?:landmark|near|next to|reference)\s*[:=]\s*"), "it is near the "),
+          (re.compile(r"\b(?:hint|note|tip|clue|fyi)\s*[:=]\s*"), ""))
 # clause words that name nothing: "which can be found lying on the bed", "the chair which you will
 # find beside the fridge", "that happens to be", "that's been placed", "the one that's got a
 # painting above it", "the location of the toilet"
@@ -1513,6 +1519,9 @@ def _rewrite_text(text: str) -> str:
     text = NEITHER_NOR.sub(r"not\1and not", GENERIC_THING.sub(r"\1one", text))
     # emoticons are no field form ("the living room :)" read a field "room:") and no words
     text = EMOTICON.sub(" ", text)
+    # written short: "b/w", "w/", "nr", "@", an arrow between steps
+    for short, said in SHORTHAND:
+        text = short.sub(said, text)
     text = MISSION_ASIDE.sub(" ", text)
     for form, said in FIELDS:
         text = form.sub(said, text)

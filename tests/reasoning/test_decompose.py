@@ -1244,3 +1244,18 @@ def test_more_ways_of_saying_where_it_stands(parser, text, relation) -> None:
 def test_a_mistyped_or_casual_article_is_no_attribute(parser, text, target) -> None:
     task = parser.parse(text)
     assert task.targets == (target,) and not task.attributes
+
+
+@pytest.mark.parametrize("text,relation", [
+    ("Find the chair nr the fridge.", ("chair", "near", "fridge")),  # the fridge was the target
+    ("Find the chair w/ the fridge next to it.", ("chair", "with", "fridge")),
+    ("Find the chair b/w the table and the window.", ("chair", "between", "dining_table")),  # a "chair_b"
+    ("Find the chair @ kitchen", ("chair", "in", "kitchen")),  # a "chair_kitchen"
+    ("Go to kitchen -> find chair near fridge", ("chair", "near", "fridge")),
+    ("Target = chair; landmark = fridge; room = kitchen", ("chair", "in", "kitchen")),  # fields with "="
+])
+def test_requests_written_short(parser, text, relation) -> None:
+    task = parser.parse(text)
+    assert task.targets == ("chair",)
+    assert relation in task.relations
+    assert not task.attributes
