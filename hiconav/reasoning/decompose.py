@@ -379,7 +379,7 @@ AFTERWARDS = re.compile(
 LEAD_IN = re.compile(
     r"^(?:(?:if you (?:don't|do not) mind|when you (?:get|have) (?:a|the) (?:chance|moment|minute|second)|"
     r"whenever you can|if you can|if possible|when you can|at your convenience|when you're ready|"
-    r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh|please|i beg you|"
+    r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh|please|yo|hey|i beg you|"
     r"i'm begging you|i implore you|i ask you|i'm asking you)"
     r"(?:\s+(?:so|then|um|uh|now|well))*\s*(?:,\s*|$)|"
     r"(?:so\s+|um\s+|okay\s+|ok\s+)*(?:i was wondering if you could|i'd appreciate it if you could|"
@@ -557,7 +557,8 @@ NEEDS: tuple[tuple[str, str], ...] = (
      r"throw (?:this|it|something|that|the trash|the rubbish|the garbage|trash|rubbish|garbage)? ?away|"
      r"dispose of (?:this|it|something)|get rid of (?:this|it|some trash)", "garbage can"),
     (r"put (?:my |our |the )?(?:dirty )?(?:clothes|laundry)", "laundry hamper"),
-    (r"use the (?:toilet|bathroom|restroom|loo|lavatory)|pee|poop|go potty", "toilet"),
+    (r"use the (?:toilet|bathroom|restroom|loo|lavatory)|pee|poop|go potty|take a leak|relieve myself|"
+     r"go to the (?:toilet|bathroom|restroom|loo|lavatory|washroom)", "toilet"),
     (r"take a bath|have a bath|bathe|have a soak", "bathtub"),
     (r"work|study|do (?:my |some )?homework|write", "desk"),
 )
@@ -565,7 +566,7 @@ NEED_ASK = re.compile(
     r"^(?:where (?:can|do|could|should|would|may) (?:i|we)|(?:(?:i|we) (?:need|want|would like|'d like) you to )?"
     r"(?:find|show|get|take|bring|lead|guide)(?: me| us)?(?: to)?\s+"
     r"(?:somewhere|something|a place|a spot|anywhere|a good (?:place|spot))(?: (?:comfy|comfortable|nice|good|quiet|warm))?"
-    r"(?: (?:where|so) (?:i|we) can| (?:i|we) can| to| for)?|(?:i|we) (?:need|want|would like|'d like|have) to|"
+    r"(?: (?:where|so) (?:i|we) can| (?:i|we) can| to| for)?|(?:i|we) (?:need|want|would like|'d like|have|got) to|(?:i|we) gotta|"
     r"(?:i|we) (?:need|want) (?:somewhere|something|a place) to|(?:somewhere|something|a place|a spot)"
     r"(?: to| (?:where )?(?:i|we) can)|(?:i|we) (?:really )?(?:need|have to use|need to use))\s+"
     r"(?P<need>" + "|".join(f"(?:{need})" for need, _ in NEEDS) + r")\b(?P<rest>[a-z' ]*)$")
@@ -774,7 +775,7 @@ FILLERS = frozenset([
     "apparently", "possibly", "hopefully", "definitely",
 ])
 # a sentence of only these words addresses the robot and names nothing ("Robot, find the laptop")
-VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me",
+VOCATIVES = frozenset(["hey", "hi", "hello", "ok", "okay", "alright", "robot", "buddy", "please", "excuse", "me", "yo",
                        "thanks", "thank", "you", "so", "um", "uh", "well", "no", "nope", "yes", "yeah", "sorry",
                        "wait", "oh"])
 # what introduces the object after a relation said first ("in the bedroom there is a TV")
@@ -1513,6 +1514,8 @@ def _rewrite_text(text: str) -> str:
     # what is wanted: the words name no object
     text = GO_THERE.sub("", IF_YOU_LOOK.sub("", DURATION_STATE.sub("", PREFERENCE.sub("", text))))
     text = NEAREST_TO.sub(r"\2 \1 to ", SEE_IF_THERE.sub("go to ", AVOID.sub("", text)))
+    # "where did the cat's bed go?": the cat's bed
+    text = re.sub(r"\bwhere did ((?:the|my|our|your)\s+[a-z' ]+?)\s+go\b", r"find \1", text)
     text = END_OF_OBJECT.sub("next to ", text)
     # "the TV stand with the vase on top": on it (a counter top was read)
     text = re.sub(r"\bon top\b(?!\s+of\b)", "on it", text)

@@ -1259,3 +1259,21 @@ def test_requests_written_short(parser, text, relation) -> None:
     assert task.targets == ("chair",)
     assert relation in task.relations
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,target", [
+    ("I gotta pee.", "toilet"),  # "i", "gotta" on the toilet
+    ("Where can I take a leak?", "toilet"),  # a "take_leak"
+    ("I need to go to the bathroom.", "toilet"),  # no object found
+    ("Where did the cat's bed go?", "dog_bed"),  # a "bed_go"
+    ("Yo, where's the fridge at?", "fridge"),  # a "where'" with the fridge
+])
+def test_casual_needs_and_questions(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert not task.attributes and not task.relations
+
+
+def test_going_to_the_bathroom_to_do_something_there_is_still_a_room(parser) -> None:
+    task = parser.parse("Go to the bathroom and find the sink.")
+    assert task.targets == ("sink",) and task.relations == (("sink", "in", "bathroom"),)
