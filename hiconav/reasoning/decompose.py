@@ -344,7 +344,7 @@ fetch|grab|pick up|get me|bring|go back to|head back to|walk back to|come back t
 bring me back to|lead me back to|
 go down to|walk down to|head down to|head up to|
 take me|bring me|lead me|guide me to|escort me to|lead the way to|show me the way to|show me where|nav to|
-seek out|navigate toward|head toward|move toward|walk toward|go toward|where might i find|where could i find|
+i'm after|i am after|we're after|seek out|navigate toward|head toward|move toward|walk toward|go toward|where might i find|where could i find|
 take a look at|take a peek at|take a quick look at|have a peek at|have a quick look at|check out|inspect|
 possibly|kindly|pls|plz|goto|would it be possible to|is it possible to|would you mind|finding|locating|
 how do i get to|how can i get to|where do you keep|where would i find|where can i find|where do i find|
@@ -653,7 +653,11 @@ WANTED = re.compile(
     r"(?:want|need|mean|seek|looking for|after|have in mind)(?:\s+to\s+(?:find|reach|see))?\s+is\s+"
     r"|\s+(?:that\s+|which\s+)?(?:i|you|we)(?:'re|'m|\s+are|\s+am)?\s+"
     r"(?:want|need|mean|seek|looking for|after|have in mind)(?:\s+to\s+(?:find|reach|see))?\s+is\s+"
-    r"(?:the one\s+)?")
+    r"(?:the one\s+)?"
+    # "the armchair I'm thinking of is in the living room", "the painting I mean hangs in ..."
+    r"|\s+(?:that\s+|which\s+)?(?:i|you|we)(?:'re|'m|\s+are|\s+am)?\s+"
+    r"(?:want|need|mean|seek|looking for|after|have in mind|thinking of|thinking about|talking about)"
+    r"(?=\s+(?:is|are|hangs|sits|stands|lies|should be)\b)")
 # why the speaker asks, at the end: "bring me to the tv so I can watch the news"
 PURPOSE = re.compile(r",?\s+(?:so that|so|because|since|in order that)\s+(?:i|we|i'd|we'd|i'm|we're)\b[^.!?;,]*")
 FINAL_COURTESY = re.compile(
@@ -1002,7 +1006,9 @@ class OfflineParser:
             if targets and self._promote(words, targets, related, relations):
                 continue
             refers_to_target = bool(targets) and self._refers_to_target(words, targets)
+            asked = words
             words = self._strip_imperatives(words)
+            asked = words != asked  # a request's words were stripped: the sentence asks
             if not words or all(w in VOCATIVES for w in words):
                 continue  # "Hey robot, go to ...": the robot addressed, no object named
             words = self._unstrand(self._front(words))
@@ -1040,7 +1046,10 @@ class OfflineParser:
                 if not targets and objs:
                     targets += objs
                     went_to = bool(GO_LEAD.match(sentence))
-                    stated = bool(SPEAKER_STATEMENT.match(sentence)) and not went_to and not FIND_LEAD.match(sentence)
+                    # told, not asked: "My phone is on the nightstand.", "In the living room,
+                    # you'll see a sofa."
+                    stated = (bool(SPEAKER_STATEMENT.match(sentence)) or not asked) and not went_to \
+                        and not FIND_LEAD.match(sentence)
                 elif ((went_to and FIND_LEAD.match(sentence)) or (stated and (FIND_LEAD.match(sentence) or GO_LEAD.match(sentence)))) \
                         and objs and objs[0].label != targets[0].label:
                     # "go to the kitchen island and find the stool beside it": the object to

@@ -1277,3 +1277,21 @@ def test_casual_needs_and_questions(parser, text, target) -> None:
 def test_going_to_the_bathroom_to_do_something_there_is_still_a_room(parser) -> None:
     task = parser.parse("Go to the bathroom and find the sink.")
     assert task.targets == ("sink",) and task.relations == (("sink", "in", "bathroom"),)
+
+
+@pytest.mark.parametrize("text,target,relation", [
+    # what the speaker has in mind ("i'm_thinking", "i_mean" were the targets)
+    ("The armchair I'm thinking of is in the living room. It's next to the floor lamp.", "armchair",
+     ("armchair", "next to", "floor_lamp")),
+    ("The painting I mean hangs in the bedroom, above the bed.", "painting", ("painting", "above", "bed")),
+    ("I'm after the plant that sits on the dresser.", "plant", ("plant", "on", "dresser")),
+    # a scene described first, then the object asked for (the sofa was the target)
+    ("In the living room, you'll see a sofa. Next to it there's an armchair. Go to the armchair.", "armchair",
+     ("armchair", "next to", "sofa")),
+    ("In the kitchen there is a fridge. Go to the chair beside it.", "chair", ("chair", "next to", "fridge")),
+])
+def test_what_the_speaker_has_in_mind_and_a_scene_described_first(parser, text, target, relation) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert relation in task.relations
+    assert not task.attributes
