@@ -486,6 +486,8 @@ SEEN_BEFORE = re.compile(r"\s+(?:that\s+|which\s+)?(?:you|we|i)\s+(?:saw|passed|
 # the kind a corrected "the one ..." is of: the first object said with a relation before the correction
 KIND_BEFORE = re.compile(r"\b(?:the|a|an)\s+([a-z' ]+?)\s+(?:next to|near|by|beside|in|on|under|above|below|behind|"
                          r"close to|opposite|facing|at|in front of)\b")
+# every room name, longest first, as one regex alternation
+_ROOM_ALTERNATION = "|".join(sorted(map(re.escape, ROOMS), key=len, reverse=True))
 # what people write short ("the chair b/w the table and the window", "w/ the fridge next to it",
 # "nr the fridge", "@ kitchen", "go to kitchen -> find the chair")
 SHORTHAND = ((re.compile(r"\bb/w\b"), "between"), (re.compile(r"\bw/o\b"), "without"),
@@ -498,23 +500,23 @@ EMOTICON = re.compile(r"(?:(?<=\s)|^)[:;=]-?[()\[\]dp]+(?=\s|$|[.!?])|[\u2600-\u
 MISSION_ASIDE = re.compile(r",?\s*should you (?:choose to |decide to )?accept it\s*[:,]?")
 # a condition at the end that names no place ("... if you look around", "if you search carefully")
 IF_YOU_LOOK = re.compile(r"\s*,?\s+if you (?:look|search|check|explore|go looking)(?:\s+(?:around|carefully|closely|"
-                         r"hard|well|in there|there|for it))?" + r"(?=\s*(?:[,.;!?]|$))")
+                         r"hard|well|in there|there|for it))?" + _CLAUSE_END)
 # a last clause that only says to go where the description pointed ("...; head over there")
 GO_THERE = re.compile(r"(?:[.;,!]\s*|\s+(?:and|then|and then)\s+)(?:please\s+)?(?:head|go|walk|move|drive|navigate|get|come)"
                       r"(?:\s+over)?\s+there(?:\s+(?:please|now))?\s*[.!]*\s*$")
 # a place to keep out of, after the request ("find the bed, but avoid the kitchen")
 AVOID = re.compile(r"\s*,?\s*(?:but\s+|and\s+)?(?:please\s+)?(?:avoid|stay out of|keep out of|stay away from|"
                    r"(?:don't|do not) (?:go|walk|drive) (?:into|in|through)|without going (?:into|in|through))\s+"
-                   r"(?:the|a|an|my|our)\s+[a-z' ]+?(?=\s*(?:[,.;!?]|$))")
+                   r"(?:the|a|an|my|our)\s+[a-z' ]+?" + _CLAUSE_END)
 # "see if there's milk in the fridge": the fridge
 SEE_IF_THERE = re.compile(r"\b(?:see|check|look|find out)\s+(?:if|whether)\s+there(?:'s|\s+is|\s+are)\s+(?:any\s+|some\s+)?"
                           r"[a-z' ]+?\s+(?:in|on|inside|at|by|near)\s+(?=(?:the|my|our)\b)"
-                          r"(?!(?:the|my|our)\s+(?:" + "|".join(sorted(map(re.escape, ROOMS), key=len, reverse=True))
+                          r"(?!(?:the|my|our)\s+(?:" + _ROOM_ALTERNATION
                           + r")\b)")  # "... a plant in the kitchen": the plant, in the kitchen
 # "the bench at the end of the bed": beside it (at the end of a room is in it: "the plant at the
 # far end of the hallway")
 END_OF_OBJECT = re.compile(r"\bat the (?:far |other )?end of (?=(?:the|a|an|my|our)\s+(?!(?:"
-                           + "|".join(sorted(map(re.escape, ROOMS), key=len, reverse=True)) + r")\b))")
+                           + _ROOM_ALTERNATION + r")\b))")
 # "the nearest chair to the window": the chair nearest to it (the window was read as the target)
 NEAREST_TO = re.compile(r"\b(nearest|closest)\s+([a-z]+(?:\s+[a-z]+)?)\s+to\s+(?=(?:the|a|an|my|our)\b)")
 # how much the speaker prefers what follows: "a TV, preferably in the bedroom"
@@ -1006,9 +1008,9 @@ class OfflineParser:
             if targets and self._promote(words, targets, related, relations):
                 continue
             refers_to_target = bool(targets) and self._refers_to_target(words, targets)
-            asked = words
+            said = words
             words = self._strip_imperatives(words)
-            asked = words != asked  # a request's words were stripped: the sentence asks
+            asked = words != said  # a request's words were stripped: the sentence asks
             if not words or all(w in VOCATIVES for w in words):
                 continue  # "Hey robot, go to ...": the robot addressed, no object named
             words = self._unstrand(self._front(words))
