@@ -344,7 +344,9 @@ fetch|grab|pick up|get me|bring|go back to|head back to|walk back to|come back t
 bring me back to|lead me back to|
 go down to|walk down to|head down to|head up to|
 take me|bring me|lead me|guide me to|escort me to|lead the way to|show me the way to|show me where|nav to|
-i'm after|i am after|we're after|seek out|navigate toward|head toward|move toward|walk toward|go toward|where might i find|where could i find|
+i'm after|i am after|we're after|seek out|do you know where|any idea where|do you know|any idea|where would|which way to|which way is|
+can you point me to|point me to|looking for|need|would love to find|would love to|got|anyone seen|has anyone seen|
+i can't find|i cannot find|i can not find|navigate toward|head toward|move toward|walk toward|go toward|where might i find|where could i find|
 take a look at|take a peek at|take a quick look at|have a peek at|have a quick look at|check out|inspect|
 possibly|kindly|pls|plz|goto|would it be possible to|is it possible to|would you mind|finding|locating|
 how do i get to|how can i get to|where do you keep|where would i find|where can i find|where do i find|
@@ -1528,6 +1530,9 @@ def _rewrite_text(text: str) -> str:
     # "where did the cat's bed go?": the cat's bed
     text = re.sub(r"\bwhere did ((?:the|my|our|your)\s+[a-z' ]+?)\s+go\b", r"find \1", text)
     text = END_OF_OBJECT.sub("next to ", text)
+    # a question after the object that names nothing: "I can't find the remote, can you?",
+    # "The fridge, where is it?"
+    text = re.sub(r"\s*,\s*(?:can|could|will|would) you\s*[?.!]*\s*$|\s*,\s*where(?:'s| is) it\s*[?.!]*\s*$", "", text)
     # "the TV stand with the vase on top": on it (a counter top was read)
     text = re.sub(r"\bon top\b(?!\s+of\b)", "on it", text)
     text = NEITHER_NOR.sub(r"not\1and not", GENERIC_THING.sub(r"\1one", text))

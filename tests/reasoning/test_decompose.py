@@ -1295,3 +1295,22 @@ def test_what_the_speaker_has_in_mind_and_a_scene_described_first(parser, text, 
     assert task.targets == (target,)
     assert relation in task.relations
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,target", [
+    ("I can't find the remote, can you?", "remote_control"),  # a second target "can_you"
+    ("The fridge, where is it?", "fridge"),  # a second target "where"
+    ("Where would the toilet be?", "toilet"),
+    ("Which way to the bathtub?", "bathtub"),
+    ("Can you point me to the fridge?", "fridge"),
+    ("Looking for the washing machine.", "washing_machine"),
+    ("Need the microwave.", "microwave"),
+    ("Would love to find the bookshelf.", "shelving_unit"),
+    ("Got a toaster around here?", "toaster"),
+    ("Anyone seen the trash can?", "garbage_can"),
+    ("Any idea where the TV is?", "tv"),
+])
+def test_questions_and_clipped_requests(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert not task.attributes
