@@ -110,8 +110,8 @@ def read_labels(anchor: Any, observed: set[int]) -> set[str]:
     label went where (``object_labels`` empty), every label the frame saw.
 
     A look-alike beside a target (a sink by a toilet, an armchair by a sofa) is observed in the
-    same frames as the target, and read by every label of the frame it counted as read as the
-    target, so that the frames of a bathroom confirmed the sink."""
+    same frames as the target; read by every label of the frame, it counted as read as the
+    target, and the frames of a bathroom confirmed the sink."""
     ids = tuple(getattr(anchor, "object_ids", ()))
     per_object = tuple(getattr(anchor, "object_labels", ()))
     if observed and len(per_object) == len(ids):

@@ -364,15 +364,17 @@ i'd like to be taken to|i would like to be taken to|i want to be taken to|i need
 """.replace("\n", "").strip("|").split("|"), key=lambda p: -len(p)))
 
 # a last command of what to do on arrival ("... and stop there", ", then wait", ". Stop.")
+# how a last clause joins what it follows: ", and then please ...", ". ...", "; ..."
+_LAST_CLAUSE = r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?"
 FINAL_COMMAND = re.compile(
-    r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?(?:stop|wait|stay|halt|remain)"
+    _LAST_CLAUSE + r"(?:stop|wait|stay|halt|remain)"
     r"(?:\s+(?:there|here|next to it|by it|in front of it|beside it|when you get there|when you arrive|"
     r"once you are there|once you get there|"
     r"(?:when|once|as soon as)\s+(?:you(?:'re|\s+are|\s+get)\s+(?:close to|near|next to|by|at)\s+it|you\s+(?:find|see|reach|spot)\s+it)))?"
     r"(?:\s+please)?\s*[.!]*\s*$")
 # what to report or do after arriving: "find the bed and let me know", "... and come back"
 AFTERWARDS = re.compile(
-    r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?(?:let me know|tell me|report back|report|"
+    _LAST_CLAUSE + r"(?:let me know|tell me|report back|report|"
     r"come back|return|come back to me|return to me|wait for me|call me|ping me|notify me)"
     r"(?:\s+(?:when|once|if)\s+[a-z' ]+)?(?:\s+please)?\s*[.!?]*\s*$|"
     r",\s*(?:can|could) you (?:go )?(?:check|confirm)(?: that| it| for me)?\s*[.!?]*\s*$")
@@ -504,8 +506,15 @@ MISSION_ASIDE = re.compile(r",?\s*should you (?:choose to |decide to )?accept it
 IF_YOU_LOOK = re.compile(r"\s*,?\s+if you (?:look|search|check|explore|go looking)(?:\s+(?:around|carefully|closely|"
                          r"hard|well|in there|there|for it))?" + _CLAUSE_END)
 # a last clause that only says to go where the description pointed ("...; head over there")
-GO_THERE = re.compile(r"(?:[.;,!]\s*|\s+(?:and|then|and then)\s+)(?:please\s+)?(?:head|go|walk|move|drive|navigate|get|come)"
+GO_THERE = re.compile(_LAST_CLAUSE + r"(?:head|go|walk|move|drive|navigate|get|come)"
                       r"(?:\s+over)?\s+there(?:\s+(?:please|now))?\s*[.!]*\s*$")
+# a question after the object that names nothing: "I can't find the remote, can you?", "The
+# fridge, where is it?"
+QUESTION_TAIL = re.compile(r"\s*,\s*(?:can|could|will|would) you\s*[?.!]*\s*$|\s*,\s*where(?:'s| is) it\s*[?.!]*\s*$")
+# "where did the cat's bed go?": the cat's bed
+WHERE_DID_GO = re.compile(r"\bwhere did ((?:the|my|our|your)\s+[a-z' ]+?)\s+go\b")
+# "the TV stand with the vase on top": on it (a counter top was read)
+ON_TOP = re.compile(r"\bon top\b(?!\s+of\b)")
 # a place to keep out of, after the request ("find the bed, but avoid the kitchen")
 AVOID = re.compile(r"\s*,?\s*(?:but\s+|and\s+)?(?:please\s+)?(?:avoid|stay out of|keep out of|stay away from|"
                    r"(?:don't|do not) (?:go|walk|drive) (?:into|in|through)|without going (?:into|in|through))\s+"
@@ -547,7 +556,6 @@ NEEDS: tuple[tuple[str, str], ...] = (
      r"wash (?:the |some |my |our )?dishes|do (?:the )?dishes", "sink"),
     (r"(?:store|keep|put away|fold) (?:my |our |the )?clothes", "dresser"),
     (r"(?:put|set) (?:my |our |the )?laptop(?: down)?", "desk"),
-    (r"(?:the |a )?(?:bathroom|restroom|washroom|lavatory|loo)", "toilet"),
     (r"cook|fry|boil (?:some )?(?:water|eggs|pasta)", "stove"),
     (r"watch (?:some |the )?(?:tv|television)|watch (?:tv|television|the news|a movie|a film|a show|the game)", "tv"),
     (r"keep (?:the |my |our )?(?:food|milk|drinks) cold|get a cold drink|chill (?:my |the |a )?(?:drink|drinks|beer|wine)",
@@ -562,7 +570,8 @@ NEEDS: tuple[tuple[str, str], ...] = (
      r"dispose of (?:this|it|something)|get rid of (?:this|it|some trash)", "garbage can"),
     (r"put (?:my |our |the )?(?:dirty )?(?:clothes|laundry)", "laundry hamper"),
     (r"use the (?:toilet|bathroom|restroom|loo|lavatory)|pee|poop|go potty|take a leak|relieve myself|"
-     r"go to the (?:toilet|bathroom|restroom|loo|lavatory|washroom)", "toilet"),
+     r"go to the (?:toilet|bathroom|restroom|loo|lavatory|washroom)|(?:the |a )?(?:bathroom|restroom|washroom|lavatory|loo)",
+     "toilet"),
     (r"take a bath|have a bath|bathe|have a soak", "bathtub"),
     (r"work|study|do (?:my |some )?homework|write", "desk"),
 )
@@ -1047,15 +1056,14 @@ class OfflineParser:
                 room_only = [p for p in subjects if p.room]
                 objs = [p for p in subjects if p.room is None]
                 rooms += [p.room for p in room_only]
+                goes, finds = bool(GO_LEAD.match(sentence)), bool(FIND_LEAD.match(sentence))
                 if not targets and objs:
                     targets += objs
-                    went_to = bool(GO_LEAD.match(sentence))
+                    went_to = goes
                     # told, not asked: "My phone is on the nightstand.", "In the living room,
                     # you'll see a sofa."
-                    stated = (bool(SPEAKER_STATEMENT.match(sentence)) or not asked) and not went_to \
-                        and not FIND_LEAD.match(sentence)
-                elif ((went_to and FIND_LEAD.match(sentence)) or (stated and (FIND_LEAD.match(sentence) or GO_LEAD.match(sentence)))) \
-                        and objs and objs[0].label != targets[0].label:
+                    stated = (bool(SPEAKER_STATEMENT.match(sentence)) or not asked) and not goes and not finds
+                elif ((went_to and finds) or (stated and (finds or goes))) and objs and objs[0].label != targets[0].label:
                     # "go to the kitchen island and find the stool beside it": the object to
                     # find is the target, the place gone to is related ("it" in this sentence);
                     # "My glasses are next to the laptop. Take me to the laptop.": what the
@@ -1523,19 +1531,18 @@ def _rewrite_text(text: str) -> str:
     text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
     # "a plant that isn't in the bathroom" says what it is not, as "is not" does
     text = re.sub(r"\b(is|are|was|were)n't\b", r"\1 not", text)
-    # a preference ("a TV, preferably in the bedroom", "ideally the one by the window") is
-    # what is wanted: the words name no object
-    text = GO_THERE.sub("", IF_YOU_LOOK.sub("", DURATION_STATE.sub("", PREFERENCE.sub("", text))))
-    text = NEAREST_TO.sub(r"\2 \1 to ", SEE_IF_THERE.sub("go to ", AVOID.sub("", text)))
-    # "where did the cat's bed go?": the cat's bed
-    text = re.sub(r"\bwhere did ((?:the|my|our|your)\s+[a-z' ]+?)\s+go\b", r"find \1", text)
+    # words that name no object: a preference, how long to stay or a device's state, a last
+    # condition, a last "go there", a place to avoid (in this order)
+    for rule in (PREFERENCE, DURATION_STATE, IF_YOU_LOOK, GO_THERE, AVOID):
+        text = rule.sub("", text)
+    text = SEE_IF_THERE.sub("go to ", text)
+    text = NEAREST_TO.sub(r"\2 \1 to ", text)
+    text = WHERE_DID_GO.sub(r"find \1", text)
     text = END_OF_OBJECT.sub("next to ", text)
-    # a question after the object that names nothing: "I can't find the remote, can you?",
-    # "The fridge, where is it?"
-    text = re.sub(r"\s*,\s*(?:can|could|will|would) you\s*[?.!]*\s*$|\s*,\s*where(?:'s| is) it\s*[?.!]*\s*$", "", text)
-    # "the TV stand with the vase on top": on it (a counter top was read)
-    text = re.sub(r"\bon top\b(?!\s+of\b)", "on it", text)
-    text = NEITHER_NOR.sub(r"not\1and not", GENERIC_THING.sub(r"\1one", text))
+    text = QUESTION_TAIL.sub("", text)
+    text = ON_TOP.sub("on it", text)
+    text = GENERIC_THING.sub(r"\1one", text)
+    text = NEITHER_NOR.sub(r"not\1and not", text)
     # emoticons are no field form ("the living room :)" read a field "room:") and no words
     text = EMOTICON.sub(" ", text)
     # written short: "b/w", "w/", "nr", "@", an arrow between steps
