@@ -87,6 +87,8 @@ class VerifySettings(_Section):
     fov_spare_deg: float = _f(8.0, "the view ring is far enough for the candidate's centre to be this far inside "
                                    "the vertical field of view", 0.0, 45.0)
     max_view_ring: float = _f(4.0, "the view ring widens for high or low objects up to this (m)", 0.3, 20.0)
+    from_here: bool = _f(True, "a robot already standing where a view cell would (within the view ring, the "
+                               "candidate in sight) judges it from there instead of driving to a view cell")
     close_ring_gap: float = _f(0.35, "frames are judged from at least this beyond the view ring (m)", 0.0, 5.0)
     close_margin: float = _f(0.25, "frames are judged this far beyond verify_distance or the view ring, and a "
                                    "closer cell must lie beyond that less this (m)", 0.0, 5.0)

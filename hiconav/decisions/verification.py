@@ -30,7 +30,7 @@ from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, evid
                                             target_labels, timeout_verdict)
 from hiconav.decisions.geometry import facing
 from hiconav.decisions.viewing import (ViewMove, blockers, close_distance, fallback_cell, nearer_candidate, next_view_move,
-                                      sight, stall_matters)
+                                      sight, stall_matters, views_from_here)
 from hiconav.types import Goal, wrap_angle
 
 #: goal tolerances (m): a closer cell, a view cell through unknown floor, a glance in place
@@ -231,6 +231,22 @@ def sight_of(settings: VerifySettings, memory: Any, task_targets: Iterable[str] 
     return sight(cand.center, camera_of(memory), hiding(settings, memory, task_targets, cand))
 
 
+def view_here(settings: VerifySettings, pose: Any, grid: Any, memory: Any, task_targets: Iterable[str] | None,
+              cand: Any, ring: float, gap: float, excluded: Iterable[np.ndarray] = ()) -> np.ndarray | None:
+    """The robot's own place (world xy) as the view cell of the candidate ``cand``, ``gap`` m from
+    its footprint, when ``from_here`` is set and ``viewing.views_from_here`` holds there (within
+    the view ``ring``, in sight past the boxes that may hide it and past walls); else None."""
+    if not settings.from_here or pose is None or grid is None:
+        return None
+    here = np.array([float(pose.x), float(pose.y)])
+    box = (np.asarray(cand.box_min), np.asarray(cand.box_max))
+    ok = views_from_here(settings, here, gap, ring, np.asarray(cand.center, dtype=np.float64), camera_of(memory),
+                         sight_of(settings, memory, task_targets, cand), grid,
+                         [box, *furniture_boxes(memory, cand.object_id)], wall_heights(memory, float(box[1][2])),
+                         excluded)
+    return here if ok else None
+
+
 def node_fields(node: Any) -> tuple[str, np.ndarray, np.ndarray, np.ndarray, float, int]:
     """A memory object ``node``'s label, centre (3,) world float64, box min and max (3,) world (as
     stored), confidence and observations: a candidate's fields as the memory has them now (the
@@ -276,4 +292,4 @@ def posting(settings: VerifySettings, verdict: Verdict, object_id: int, rejectio
 
 __all__ = ["CLOSER_TOLERANCE", "CellGoal", "GLANCE_TOLERANCE", "Judgement", "Posting", "Switch", "UNKNOWN_TOLERANCE",
            "Verification", "evidence_inputs", "hiding", "move_verdict", "nearer_switch", "node_fields",
-           "posting", "sight_of", "view_feedback"]
+           "posting", "sight_of", "view_feedback", "view_here"]

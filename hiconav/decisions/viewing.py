@@ -23,7 +23,7 @@ from typing import Any, Iterable, TypeVar
 import numpy as np
 
 from hiconav.decisions.config import VerifySettings
-from hiconav.decisions.geometry import approach_cell
+from hiconav.decisions.geometry import approach_cell, segments_blocked, wall_clear
 from hiconav.geometry import footprint_distance
 
 #: the nearest view ring (m from the footprint): nearer, the robot's body overlaps the object's
@@ -51,10 +51,50 @@ def view_ring(settings: VerifySettings, center_z: float, camera: tuple[float, fl
     base = max(settings.verify_distance - settings.view_margin, MIN_VIEW_RING)
     if camera is None:
         return base
+    return max(base, min(nearest_view(settings, center_z, camera), settings.max_view_ring))
+
+
+def nearest_view(settings: VerifySettings, center_z: float, camera: tuple[float, float] | None,
+                 spare_deg: float | None = None) -> float:
+    """The nearest distance (m from the footprint) from which the camera holds an object whose
+    centre is ``center_z`` m up inside its vertical field of view with ``spare_deg`` (default
+    ``fov_spare_deg``) to spare: ``view_ring``'s need alone, never nearer than ``MIN_VIEW_RING``."""
+    if camera is None:
+        return MIN_VIEW_RING
     height, vfov = camera
-    half = max(0.5 * vfov - math.radians(settings.fov_spare_deg), MIN_HALF_FOV)
-    need = abs(float(center_z) - height) / math.tan(half)
-    return max(base, min(need, settings.max_view_ring))
+    spare = settings.fov_spare_deg if spare_deg is None else spare_deg
+    half = max(0.5 * vfov - math.radians(spare), MIN_HALF_FOV)
+    return max(abs(float(center_z) - height) / math.tan(half), MIN_VIEW_RING)
+
+
+def views_from_here(settings: VerifySettings, robot_xy: np.ndarray, gap: float, ring: float, center: np.ndarray,
+                    camera: tuple[float, float] | None, sight_arg: tuple[np.ndarray, float, np.ndarray, np.ndarray] | None,
+                    grid: Any, explained: list[tuple[np.ndarray, np.ndarray]] | None,
+                    heights: tuple[float, float] | None, excluded: Iterable[np.ndarray] = ()) -> bool:
+    """True when the robot, ``gap`` m from the candidate's footprint, already stands where a view
+    cell would: no farther than the view ``ring``, no nearer than the camera holds the object
+    (``nearest_view``), the line from the camera to the object's ``center`` clear of the boxes
+    that may hide it (``sight_arg``, ``sight``'s value) and of walls on the map (``wall_clear``
+    with the memory's boxes ``explained``), and not a spot set aside (``excluded``, 0.3 m).
+
+    A robot that comes upon a candidate closer than the view ring (a described instance is
+    often confirmed only once the robot stands beside it and sees what is near it) judges it
+    from where it stands: a view cell out on the ring, or on the line it was first seen along,
+    would take it away from the object and the approach would bring it back."""
+    xy = np.asarray(robot_xy, dtype=np.float64)[:2]
+    if not nearest_view(settings, float(np.asarray(center)[2]), camera) <= gap <= ring:
+        return False
+    if any(float(np.hypot(*(xy - np.asarray(e, dtype=np.float64)[:2]))) <= 0.3 for e in excluded):
+        return False
+    if sight_arg is not None:
+        point, height, lo, hi = sight_arg
+        if segments_blocked(np.array([[xy[0], xy[1], float(height)]]), point, lo, hi)[0]:
+            return False
+    if grid is not None and explained is not None:
+        clear = wall_clear(grid, xy[None, :], np.asarray(center, dtype=np.float64)[:2], explained, heights=heights)
+        if not bool(clear[0]):
+            return False
+    return True
 
 
 def close_distance(settings: VerifySettings, ring: float) -> float:
@@ -272,6 +312,7 @@ def next_view_move(settings: VerifySettings, *, close: bool, sent: bool, state: 
 
 
 __all__ = ["DONE", "MIN_HALF_FOV", "MIN_VIEW_RING", "ViewMove", "blockers", "box_distance", "close_distance",
-           "closer_cell", "fallback_cell", "may_switch", "may_try_unknown", "nearer_candidate", "next_view_move", "seen_from",
+           "closer_cell", "fallback_cell", "may_switch", "may_try_unknown", "nearer_candidate", "nearest_view",
+           "next_view_move", "seen_from",
            "seen_from_node", "sight",
-           "stall_matters", "through_unknown_cell", "view_ring"]
+           "stall_matters", "through_unknown_cell", "view_ring", "views_from_here"]

@@ -204,3 +204,43 @@ def test_the_stall_clock_is_read_on_the_way_and_while_a_goal_close_by_is_in_flig
     assert view.stall_matters(close=True, sent=True, state="active")
     assert not view.stall_matters(close=True, sent=True, state="reached")
     assert not view.stall_matters(close=True, sent=False, state="pending")
+
+
+# -- judging from where the robot stands ------------------------------------------------------------
+CAMERA = (0.88, math.radians(63.0))
+TOP = np.array([5.0, 5.0, 0.8])  # the object's top half, near the camera's height
+RING = view.view_ring(S, float(TOP[2]), CAMERA)  # 1.15 m
+
+
+def _here(xy, *, grid=None, hiding=None, excluded=(), center=TOP, ring=RING) -> bool:
+    xy = np.asarray(xy, dtype=np.float64)
+    gap = view.box_distance(LO, HI, xy)
+    sight = view.sight(center, CAMERA, hiding)
+    return view.views_from_here(S, xy, gap, ring, center, CAMERA, sight, grid if grid is not None else room(),
+                                [(LO, HI)], None, excluded)
+
+
+def test_a_robot_inside_the_view_ring_with_the_object_in_sight_judges_it_from_where_it_stands():
+    assert _here([5.0, 6.3])  # 0.8 m north of the footprint
+    assert not _here([5.0, 7.0])  # 1.5 m: beyond the ring, it drives to a view cell
+    assert not _here([5.0, 5.6])  # 0.1 m: the robot's body overlaps the object
+    assert not _here([5.0, 6.3], center=CENTRE)  # a low centre drops out of the bottom of the image
+
+
+def test_a_robot_too_near_a_high_object_to_hold_it_in_view_does_not_judge_from_there():
+    tv = np.array([5.0, 5.0, 1.9])  # high on a wall: out of the top of the image from 0.8 m
+    ring = view.view_ring(S, 1.9, CAMERA)
+    assert view.nearest_view(S, 1.9, CAMERA) > 0.8
+    assert not _here([5.0, 6.3], center=tv, ring=ring)
+    assert not _here([5.0, 5.5 + ring - 0.05], center=tv, ring=ring)
+    assert _here([5.0, 5.5 + ring + 0.05], center=tv, ring=ring + 0.1)
+
+
+def test_a_robot_behind_a_chair_a_wall_or_on_a_spot_set_aside_goes_to_a_view_cell():
+    chair = (np.array([[4.7, 5.7, 0.0]]), np.array([[5.3, 6.0, 1.0]]))  # between the robot and the object
+    assert not _here([5.0, 6.3], hiding=chair)
+    walled = room()
+    walled.state[58, 40:60] = 1  # a wall 0.3 m north of the footprint, between it and the robot
+    assert not _here([5.0, 6.3], grid=walled)
+    assert not _here([5.0, 6.3], excluded=[np.array([5.1, 6.2])])
+    assert _here([5.0, 6.3], excluded=[np.array([5.0, 7.0])])

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 from pathlib import Path
@@ -1103,6 +1104,24 @@ def test_explored_out_explore_brings_deferred_candidates_back_before_failing(tmp
     assert not ctx.excluded(3)
     clock.t = 6.0
     assert tree.tick() == S.FAILURE  # nothing deferred any more: explored out
+
+
+def test_verify_judges_from_where_the_robot_stands_when_it_already_sees_the_candidate_close(tmp_path):
+    """A robot 0.7 m from the bed with nothing between judges it from there, facing it, though
+    the bed was first seen from the north (a view cell on that line would take it 2 m away and
+    the approach would bring it back); ``from_here: false`` drives to that line."""
+    sent = {}
+    for from_here in (True, False):
+        ctx = _ctx(Clock())
+        pose = Pose2D(3.8, 5.0, 1.0)
+        bed = replace(obj(3, "bed", 5.0, 5.0), anchor_ids=(1,))
+        ctx.world = world(pose, [bed], anchors=[anchor(1, Pose2D(5.0, 7.5, -1.57), (3,))])
+        tree = _confirmed_then(tmp_path, ctx, f"VerifyTarget: {{from_here: {str(from_here).lower()}}}")
+        assert tree.tick() == S.RUNNING
+        sent[from_here] = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal
+    here = sent[True]
+    assert (here.x, here.y) == (3.8, 5.0) and abs(here.yaw) < 1e-9 and here.kind == "approach"
+    assert math.hypot(sent[False].x - 3.8, sent[False].y - 5.0) > 1.0
 
 
 def test_verify_defers_a_candidate_it_gets_no_nearer_to(tmp_path):

@@ -33,8 +33,9 @@ class _GoToObject(MissionBehaviour):
         return 0.0
 
     def _prefer_weight(self) -> float:
-        """approach_cell's weight on a cell's distance to ``_preferred_xy`` (see VerifyTarget)."""
-        return 0.0
+        """approach_cell's weight on a cell's distance to ``_preferred_xy`` (``view_ray_weight``:
+        see VerifyTarget; 0 for a behaviour without it)."""
+        return float(getattr(self.settings, "view_ray_weight", 0.0))
 
     def _corner_radius(self) -> float:
         """approach_cell's rounding of the box's corners (see Approach); 0: the box."""
@@ -42,6 +43,11 @@ class _GoToObject(MissionBehaviour):
 
     def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
         """A point the approach cell should lie near, or None (no preference)."""
+        return None
+
+    def _here(self, cand: Candidate, distance: float) -> np.ndarray | None:
+        """Where the robot stands (world xy) when that will do for a cell within ``distance`` of
+        the candidate (see VerifyTarget), else None: a cell is searched."""
         return None
 
     def _sight(self, cand: Candidate) -> tuple[np.ndarray, float, np.ndarray, np.ndarray] | None:
@@ -67,6 +73,10 @@ class _GoToObject(MissionBehaviour):
                  "prefer_weight": self._prefer_weight(), "sight": self._sight(cand),
                  "furniture": self._furniture(cand), "strict_walls": strict_walls, "box_weight": box_weight,
                  "wall_heights": self._wall_heights(cand), "corner_radius": self._corner_radius()}
+        here = self._here(cand, distance)
+        if here is not None:
+            self._go_to_cell(cand, here, 0.2)
+            return True
         cell = cell_near(ctx.grid, cand.box_min, cand.box_max, np.array([pose.x, pose.y]), distance, self._excluded,
                          **rules)
         if cell is None:
@@ -83,8 +93,9 @@ class _GoToObject(MissionBehaviour):
                                                 through_unknown=through_unknown))
 
     def _stall_near(self) -> float:
-        """Within this of the goal cell the robot is there (VerifyTarget glances about its view cell)."""
-        return 0.0
+        """Within this of the goal cell the robot is there (``stall_near``: VerifyTarget glances
+        about its view cell; 0 for a behaviour without it)."""
+        return float(getattr(self.settings, "stall_near", 0.0))
 
     def _stalled(self) -> bool:
         """True when the robot has made no progress toward the goal cell for ``stall_s``."""

@@ -43,17 +43,16 @@ class VerifyTarget(_GoToObject):
             self._send(self._cand, self._ring(self._cand))
 
     # -- the hooks of _GoToObject and the inputs of the core ---------------------------------------
-    def _stall_near(self) -> float:
-        return self.param("stall_near")
-
-    def _prefer_weight(self) -> float:
-        return self.param("view_ray_weight")
-
     def _sight(self, cand: Candidate) -> tuple[np.ndarray, float, np.ndarray, np.ndarray] | None:
         return verif.sight_of(self.settings, self.context.memory, self._targets(), cand)
 
     def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
         return view.seen_from_node(cand.center, self.context.memory, self.context.object(cand.object_id), distance)
+
+    def _here(self, cand: Candidate, distance: float) -> np.ndarray | None:
+        ctx = self.context
+        return verif.view_here(self.settings, ctx.pose, ctx.grid, ctx.memory, self._targets(), cand, distance,
+                               ctx.distance_to_box(cand.box_min, cand.box_max), self._excluded)
 
     def _ring(self, cand: Candidate) -> float:
         return view.view_ring(self.settings, float(np.asarray(cand.center)[2]), self._camera())
