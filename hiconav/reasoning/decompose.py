@@ -348,6 +348,8 @@ i'm after|i am after|we're after|seek out|do you know where|any idea where|do yo
 can you point me to|point me to|looking for|need|would love to find|would love to|got|anyone seen|has anyone seen|
 i can't find|i cannot find|i can not find|navigate toward|head toward|move toward|walk toward|go toward|where might i find|where could i find|
 take a look at|take a peek at|take a quick look at|have a peek at|have a quick look at|check out|inspect|
+park at|park by|park next to|park beside|park near|park in front of|park|pull up to|pull up next to|pull up at|
+pull up beside|pull up by|pull up in front of|pull over by|pull over next to|pull over at|pull in next to|
 possibly|kindly|pls|plz|goto|would it be possible to|is it possible to|would you mind|finding|locating|
 how do i get to|how can i get to|where do you keep|where would i find|where can i find|where do i find|
 i wanna see|i want to see|i'd like to see|i would like to see|i think there's|i think there is|i believe|
@@ -408,6 +410,10 @@ WHICHEVER = re.compile(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notic
                        + _CLAUSE_END + r"|\s+(?:will|would) do" + _CLAUSE_END)
 # a side with nothing it is the side of ("the chair to the left") is the viewer's: no object, and
 # no relation a map can check
+# where in the room, said from the robot ("the sofa across the room", "at the far end of the
+# room"): no object, and nothing a map can check ("across the room from the tv" is a relation)
+ACROSS_ROOM = re.compile(r"\s+(?:over\s+)?(?:across|on the other side of|at the other end of|at the far end of|"
+                         r"at the opposite end of|on the far side of)\s+the\s+room\b(?!\s+from\b)")
 VIEWER_SIDE = re.compile(r"\s+(?:to|on) the (?:left|right)(?:\s+(?:hand\s+)?side)?\b(?!\s+(?:of|side)\b)")
 # "drive over to the armchair", "roll over to the stool": a motion, not something above the
 # armchair (nor a roll of paper towel)
@@ -451,9 +457,10 @@ HABIT = re.compile(r"(?<!something)(?<!somewhere)(?<!anything)(?<!anywhere)(?<!p
                    r"\s+(?:that\s+|which\s+)?(?:i|we|you|he|she|they|mom|dad)\s+(?:usually\s+|always\s+|often\s+|"
                    r"normally\s+|sometimes\s+|can\s+|could\s+|would\s+|will\s+|might\s+)?(?:sit on|sit in|sleep on|sleep in|use|like|love|prefer|work at|"
                    r"eat at|read in|read on|watch|lie on|rest on|relax on|relax in)\b")
-# "far from the window" says where it is not; "closer to the fridge than to the table": near
-# the first
-FAR_FROM = re.compile(r"(?<!not)\s*,?\s+(?:but\s+|and\s+)?far\s+(?:away\s+)?from\s+(?:the|a|an)\s+[a-z' ]+?"
+# "far from the window" (or "the farthest from") says where it is not; "closer to the fridge than
+# to the table": near the first
+FAR_FROM = re.compile(r"(?<!not)\s*,?\s+(?:but\s+|and\s+)?(?:far|farthest|furthest)\s+(?:away\s+)?from\s+"
+                      r"(?:the|a|an)\s+[a-z' ]+?"
                       + _CLAUSE_END)
 CLOSER_THAN = re.compile(r"\b(?:closer|nearer)\s+to\s+((?:the|a|an)\s+[a-z' ]+?)\s+than\s+(?:to\s+)?(?:the|a|an)\s+[a-z' ]+?"
                          + _CLAUSE_END)
@@ -762,6 +769,8 @@ RELATIONS: dict[str, str] = {
     "tucked in at": "next to", "tucked in to": "next to", "tucked in under": "under", "pushed in at": "next to",
     "pushed in under": "under", "sandwiched between": "between", "squeezed between": "between",
     "wedged between": "between", "nestled between": "between",
+    # what stands around it ("the dining table surrounded by chairs" read a "table_surrounded")
+    "surrounded by": "next to", "ringed by": "next to", "encircled by": "next to",
 }
 _RELATION_KEYS = sorted(RELATIONS, key=lambda p: -len(p.split()))
 
@@ -1563,7 +1572,7 @@ def _rewrite_text(text: str) -> str:
     text = WHICHEVER.sub("", text)
     # why the speaker asks names no object ("bring me to the tv so I can watch the news")
     text = PURPOSE.sub("", text)
-    text = VIEWER_SIDE.sub("", text)
+    text = ACROSS_ROOM.sub("", VIEWER_SIDE.sub("", text))
     # what to do on arrival names no object: "go to the chair by the fridge and stop there";
     # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
     text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", THATS_IT.sub("", text)))

@@ -1314,3 +1314,26 @@ def test_questions_and_clipped_requests(parser, text, target) -> None:
     task = parser.parse(text)
     assert task.targets == (target,)
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # the farthest one says where it is not ("lamp_farthest" was the target, near the bed)
+    ("Take me to the lamp farthest from the bed.", "floor_lamp", ()),
+    ("Find the armchair that is furthest from the tv.", "armchair", ()),
+    # what stands around it ("table_surrounded", a second target "surrounded")
+    ("find the dining table surrounded by chairs", "dining_table", (("dining_table", "next to", "chair"),)),
+    ("go to the chair, it's the one surrounded by plants", "chair", (("chair", "next to", "plant"),)),
+    # parking is going there ("park" was the target)
+    ("Park next to the couch.", "sofa", ()),
+    ("Pull up next to the sofa", "sofa", ()),
+    ("Please park in front of the TV in the living room", "tv", (("tv", "in", "living_room"),)),
+    # where in the room, said from the robot ("across_room" was the target)
+    ("Get over to the sofa across the room.", "sofa", ()),
+    ("go to the sofa at the other end of the room", "sofa", ()),
+    ("the armchair across the room from the tv", "armchair", (("armchair", "opposite", "tv"),)),
+])
+def test_the_farthest_one_what_surrounds_it_parking_and_across_the_room(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert not task.attributes
