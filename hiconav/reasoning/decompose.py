@@ -348,6 +348,8 @@ i'm after|i am after|we're after|seek out|do you know where|any idea where|do yo
 can you point me to|point me to|looking for|need|would love to find|would love to|got|anyone seen|has anyone seen|
 i can't find|i cannot find|i can not find|navigate toward|head toward|move toward|walk toward|go toward|where might i find|where could i find|
 take a look at|take a peek at|take a quick look at|have a peek at|have a quick look at|check out|inspect|
+go get|go grab|go fetch|i'm going to go to|i am going to go to|i'm gonna go to|i am gonna go to|i'm going to|
+i'm gonna go|
 park at|park by|park next to|park beside|park near|park in front of|park|pull up to|pull up next to|pull up at|
 pull up beside|pull up by|pull up in front of|pull over by|pull over next to|pull over at|pull in next to|
 possibly|kindly|pls|plz|goto|would it be possible to|is it possible to|would you mind|finding|locating|
@@ -405,9 +407,12 @@ ROBOT_OBJECT = re.compile(r"\b(?:navigate|move|send|drive|take|bring|get|steer|g
 # the end of a clause, looked ahead to
 _CLAUSE_END = r"(?=\s*(?:[,.;!?]|$))"
 # which one is meant by when it is met, or that any will do ("the first chair you see", "any
-# laptop will do"): no object, and nothing a map can check; only at a clause's end ("can you find")
+# laptop will do", "the bed or the sofa, whichever is closer"): no object, and nothing a map can
+# check; only at a clause's end ("can you find")
 WHICHEVER = re.compile(r"\s+(?:that\s+)?you\s+(?:see|find|come across|spot|notice|encounter)(?:\s+first)?"
-                       + _CLAUSE_END + r"|\s+(?:will|would) do" + _CLAUSE_END)
+                       + _CLAUSE_END + r"|\s+(?:will|would) do" + _CLAUSE_END
+                       + r"|\s*,?\s+whichever(?:\s+one)?\s+(?:is|'s)\s+(?:closer|nearer|closest|nearest|easier|quicker)"
+                       r"(?:\s+to\s+(?:you|me|reach|get to))?" + _CLAUSE_END)
 # a side with nothing it is the side of ("the chair to the left") is the viewer's: no object, and
 # no relation a map can check
 # where in the room, said from the robot ("the sofa across the room", "at the far end of the
@@ -520,6 +525,22 @@ GO_THERE = re.compile(_LAST_CLAUSE + r"(?:head|go|walk|move|drive|navigate|get|c
 QUESTION_TAIL = re.compile(r"\s*,\s*(?:can|could|will|would) you\s*[?.!]*\s*$|\s*,\s*where(?:'s| is) it\s*[?.!]*\s*$")
 # "where did the cat's bed go?": the cat's bed
 WHERE_DID_GO = re.compile(r"\bwhere did ((?:the|my|our|your)\s+[a-z' ]+?)\s+go\b")
+# "where did I leave my laptop?": asks for the laptop (a "where_did_i_leave" was read on it)
+WHERE_DID_PUT = re.compile(r"\bwhere did (?:i|we|you|he|she|they|mom|dad)\s+(?:last\s+)?(?:leave|put|drop|see|stash|"
+                           r"hide|park|set)\s+(?=(?:the|my|our|your|his|her|their)\b)")
+# how the robot is to move there ("go straight to the sofa", "move forward to the dresser" read
+# "to" and "move forward to" as words of the sofa and the dresser)
+MOTION_ADVERB = re.compile(r"\b(go|head|move|drive|walk|run|come|navigate|proceed|travel|roll|get)\s+(?:straight ahead|"
+                           r"straight|directly|forward|forwards|right)\s+(?=(?:to|for|towards|toward|over|into|up)\b)")
+# an urgent need said after the request ("go to the toilet now, I really need to go" sought a
+# "to_go"); said alone it is the need itself (NEEDS: the toilet)
+URGENCY = re.compile(r"[,;.!]?\s*(?:(?:and|because|cause|'cause|coz|cuz)\s+)?(?:i|we)\s+(?:really\s+|seriously\s+|"
+                     r"desperately\s+|badly\s+)?(?:need|have|got|gotta)\s+(?:to\s+)?go(?:\s+(?:so\s+bad|so\s+badly|"
+                     r"badly|really\s+bad|now))?\s*[.!]*\s*$")
+# "the thing you sit on" is what one does it on ("thing" was the target), as "something I can sit on"
+THING_FOR = re.compile(r"\b(?:the|a|that)\s+(?:thing|things|piece of furniture|furniture)\s+(?:that\s+|which\s+)?"
+                       r"(?:i|you|we|people|one|they)\s+(?:can\s+|could\s+|usually\s+|normally\s+|always\s+)?"
+                       r"(sit|sleep|nap|relax|rest|lounge|cook|work|study|bathe)\s+(?:on|in|at)\b")
 # "the TV stand with the vase on top": on it (a counter top was read)
 ON_TOP = re.compile(r"\bon top\b(?!\s+of\b)")
 # a place to keep out of, after the request ("find the bed, but avoid the kitchen")
@@ -577,6 +598,7 @@ NEEDS: tuple[tuple[str, str], ...] = (
      r"dispose of (?:this|it|something)|get rid of (?:this|it|some trash)", "garbage can"),
     (r"put (?:my |our |the )?(?:dirty )?(?:clothes|laundry)", "laundry hamper"),
     (r"use the (?:toilet|bathroom|restroom|loo|lavatory)|pee|poop|go potty|take a leak|relieve myself|"
+     r"go(?: so bad| so badly| badly| really bad| now)?(?=\s*$)|"
      r"go to the (?:toilet|bathroom|restroom|loo|lavatory|washroom)|(?:the |a )?(?:bathroom|restroom|washroom|lavatory|loo)",
      "toilet"),
     (r"take a bath|have a bath|bathe|have a soak", "bathtub"),
@@ -586,10 +608,16 @@ NEED_ASK = re.compile(
     r"^(?:where (?:can|do|could|should|would|may) (?:i|we)|(?:(?:i|we) (?:need|want|would like|'d like) you to )?"
     r"(?:find|show|get|take|bring|lead|guide)(?: me| us)?(?: to)?\s+"
     r"(?:somewhere|something|a place|a spot|anywhere|a good (?:place|spot))(?: (?:comfy|comfortable|nice|good|quiet|warm))?"
-    r"(?: (?:where|so) (?:i|we) can| (?:i|we) can| to| for)?|(?:i|we) (?:need|want|would like|'d like|have|got) to|(?:i|we) gotta|"
+    r"(?: (?:where|so) (?:i|we) can| (?:i|we) can| to| for)?|(?:i|we) (?:really |seriously |desperately )?"
+    r"(?:need|want|would like|'d like|have|got) to|(?:i|we) (?:really )?gotta|"
     r"(?:i|we) (?:need|want) (?:somewhere|something|a place) to|(?:somewhere|something|a place|a spot)"
     r"(?: to| (?:where )?(?:i|we) can)|(?:i|we) (?:really )?(?:need|have to use|need to use))\s+"
     r"(?P<need>" + "|".join(f"(?:{need})" for need, _ in NEEDS) + r")\b(?P<rest>[a-z' ]*)$")
+
+
+def _need_name(need: str) -> str:
+    """The object (NEEDS' name) one does ``need`` with or on ("sit": the chair)."""
+    return next(name for pattern, name in NEEDS if re.fullmatch(pattern, need))
 
 
 def _need_object(part: str) -> str | None:
@@ -603,8 +631,7 @@ def _need_object(part: str) -> str | None:
                         r"lounge|office|study)", rest)
     if room is None and rest.strip() and not re.fullmatch(r"\s*(?:on|in|at|with|please|now|here)?\s*", rest):
         return None  # "I want to sit on the sofa" names its object: ACTIVITY's rule
-    need = m.group("need")
-    name = next(name for pattern, name in NEEDS if re.fullmatch(pattern, need))
+    name = _need_name(m.group("need"))
     return f"find the {name}" + (room.group(0) if room is not None else "")
 
 
@@ -1546,7 +1573,11 @@ def _rewrite_text(text: str) -> str:
         text = rule.sub("", text)
     text = SEE_IF_THERE.sub("go to ", text)
     text = NEAREST_TO.sub(r"\2 \1 to ", text)
-    text = WHERE_DID_GO.sub(r"find \1", text)
+    text = WHERE_DID_PUT.sub("find ", WHERE_DID_GO.sub(r"find \1", text))
+    text = MOTION_ADVERB.sub(r"\1 ", text)
+    if (said := URGENCY.sub("", text)) != text and re.search(r"[a-z]", said):
+        text = said
+    text = THING_FOR.sub(lambda m: "the " + _need_name(m.group(1)), text)
     text = END_OF_OBJECT.sub("next to ", text)
     text = QUESTION_TAIL.sub("", text)
     text = ON_TOP.sub("on it", text)

@@ -1337,3 +1337,33 @@ def test_the_farthest_one_what_surrounds_it_parking_and_across_the_room(parser, 
     assert task.targets == (target,)
     assert task.relations == relations
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,targets,relations", [
+    # an urgent need after the request ("to_go" was a second target; "toilet_now" the first)
+    ("Go to the toilet ASAP I really need to go", ("toilet",), ()),
+    ("Go to the toilet now, I have to go", ("toilet",), ()),
+    # and said alone it is the need
+    ("I really need to go.", ("toilet",), ()),
+    ("I gotta go", ("toilet",), ()),
+    ("I have to go to the bathroom", ("toilet",), ()),
+    # which of two: the nearer ("closer" was a third target)
+    ("the bed or the sofa, whichever is closer", ("bed", "sofa"), ()),
+    # asking where it was left ("where", "did", "i", "leave" were words of the laptop)
+    ("Where did I leave my laptop? I think it's on the dining table.", ("laptop",),
+     (("laptop", "on", "dining_table"),)),
+    # how to move there ("to", "move forward to" were words of the sofa and the dresser)
+    ("Go straight to the sofa.", ("sofa",), ()),
+    ("Move forward to the dresser.", ("dresser",), ()),
+    ("head straight for the bed", ("bed",), ()),
+    ("I'm going to go to the bed", ("bed",), ()),
+    ("Go get the remote", ("remote_control",), ()),
+    # the thing one does something on ("thing" was the target)
+    ("Find me the thing you sit on in the living room.", ("chair",), (("chair", "in", "living_room"),)),
+    ("the thing I sleep on", ("bed",), ()),
+])
+def test_urgent_needs_whichever_is_closer_where_it_was_left_and_how_to_move(parser, text, targets, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == targets
+    assert task.relations == relations
+    assert not task.attributes
