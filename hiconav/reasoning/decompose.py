@@ -459,9 +459,17 @@ INSIST = re.compile(r"\b(?:make sure|be sure|ensure)\s+(?:that\s+)?(?=it|it's|it
 # what the speaker does with it: "the chair that I usually sit on", "the bed I sleep in": no
 # relation a view can check
 HABIT = re.compile(r"(?<!something)(?<!somewhere)(?<!anything)(?<!anywhere)(?<!place)(?<!spot)"
-                   r"\s+(?:that\s+|which\s+)?(?:i|we|you|he|she|they|mom|dad)\s+(?:usually\s+|always\s+|often\s+|"
-                   r"normally\s+|sometimes\s+|can\s+|could\s+|would\s+|will\s+|might\s+)?(?:sit on|sit in|sleep on|sleep in|use|like|love|prefer|work at|"
-                   r"eat at|read in|read on|watch|lie on|rest on|relax on|relax in)\b")
+                   r"\s+(?:that\s+|which\s+|where\s+)?(?:i|we|you|he|she|they|mom|dad|nobody|no one|everyone|everybody|"
+                   r"someone|somebody|people|the kids|the children|grandma|grandpa)\s+(?:usually\s+|always\s+|often\s+|"
+                   r"normally\s+|sometimes\s+|can\s+|could\s+|would\s+|will\s+|might\s+|ever\s+)?"
+                   r"(?:watch(?:es)? (?:the )?(?:tv|television|movies|films|the news)(?: on| in| from)?|"
+                   r"sits? on|sits? in|sleeps? on|sleeps? in|uses?|likes?|loves?|prefers?|works? at|"
+                   r"eats? at|reads? in|reads? on|watch(?:es)?|lies? on|rests? on|relax(?:es)? on|relax(?:es)? in)\b"
+                   # "the table where we eat", "the desk where I work": where one does it
+                   r"|\s+where\s+(?:i|we|you|he|she|they|mom|dad|people|the kids|the children|everyone)\s+"
+                   r"(?:usually\s+|always\s+|often\s+|normally\s+)?(?:eat|eats|work|works|sleep|sleeps|read|reads|"
+                   r"sit|sits|study|studies|cook|cooks|relax|relaxes|rest|rests|watch tv|watches tv|brush our teeth|"
+                   r"brush my teeth|wash up|wash our hands|wash my hands)" + _CLAUSE_END)
 # "far from the window" (or "the farthest from") says where it is not; "closer to the fridge than
 # to the table": near the first
 FAR_FROM = re.compile(r"(?<!not)\s*,?\s+(?:but\s+|and\s+)?(?:far|farthest|furthest)\s+(?:away\s+)?from\s+"
@@ -569,7 +577,12 @@ NEITHER_NOR = re.compile(r"\bneither\b(.{1,60}?)\bnor\b")
 # on", "switched off") name no object
 DURATION_STATE = re.compile(r"\s*\bfor\s+(?:\d+|a|an|one|two|three|five|ten|a few|a couple of|few)\s+"
                             r"(?:seconds?|secs?|minutes?|mins?|hours?)\b"
-                            r"|\s*\b(?:(?:that|which)\s+(?:is|are)\s+|that's\s+)?(?:turned|switched)\s+(?:on|off)\b")
+                            r"|\s*\b(?:(?:that|which)\s+(?:is|are)\s+|that's\s+)?(?:turned|switched)\s+(?:on|off)\b"
+                            # "the TV that is off", "the plant that needs water": a state, no object
+                            r"|\s+(?:that|which)(?:'s|\s+is|\s+are)\s+(?:on|off|plugged in|unplugged|running)"
+                            + _CLAUSE_END +
+                            r"|\s+(?:that|which)\s+needs?\s+(?:water|watering|cleaning|dusting|fixing|charging|"
+                            r"a wipe|to be (?:watered|cleaned|dusted|fixed|charged))" + _CLAUSE_END)
 
 # a request not to go somewhere, before the one that counts ("don't go to the sofa, go to ...")
 DONT = re.compile(r"^(?:please\s+)?(?:don't|do not|never)\s+(?:go to|go into|go in|enter|find|take me to|look for|head to|"
@@ -1567,6 +1580,9 @@ def _rewrite_text(text: str) -> str:
     text = text.lower().replace("\u2019", "'").replace("\u2018", "'")
     # "a plant that isn't in the bathroom" says what it is not, as "is not" does
     text = re.sub(r"\b(is|are|was|were)n't\b", r"\1 not", text)
+    # contractions written without their apostrophe ("the chair thats by the table" sought a
+    # "chair_that"); "its" is left as it is (a word of its own)
+    text = re.sub(r"\b(that|there|what|where|who)s\b", r"\1's", text)
     # words that name no object: a preference, how long to stay or a device's state, a last
     # condition, a last "go there", a place to avoid (in this order)
     for rule in (PREFERENCE, DURATION_STATE, IF_YOU_LOOK, GO_THERE, AVOID):

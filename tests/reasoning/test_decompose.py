@@ -1367,3 +1367,24 @@ def test_urgent_needs_whichever_is_closer_where_it_was_left_and_how_to_move(pars
     assert task.targets == targets
     assert task.relations == relations
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # a contraction written without its apostrophe ("chair_that" was the target)
+    ("find the chair thats by the table", "chair", (("chair", "next to", "dining_table"),)),
+    # where someone does something, and habits of others ("we_eat", "i_work", "chair_nobody")
+    ("go to the table where we eat", "dining_table", ()),
+    ("Find the desk where I work.", "desk", ()),
+    ("Go to the sink where we brush our teeth.", "sink", ()),
+    ("Take me to the couch we watch TV on.", "sofa", ()),  # the tv was the target
+    ("the chair nobody ever sits in by the window", "chair", (("chair", "next to", "window"),)),
+    # a device's or a plant's state ("tv_off", "needs_water")
+    ("go to the TV that is off", "tv", ()),
+    ("Go to the plant that needs water.", "plant", ()),
+    ("the lamp that is on the desk", "desk_lamp", (("desk_lamp", "on", "desk"),)),  # "on" a support stays
+])
+def test_contractions_without_apostrophes_habits_of_others_and_states(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert not task.attributes
