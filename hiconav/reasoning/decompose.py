@@ -489,7 +489,7 @@ ASIDE = re.compile(r",?\s*\b(?:i think|i believe|i guess|i reckon|i suppose|if i
 # "the tv attached to the wall opposite the bed": the wall is no object, what follows is said of
 # the tv; "all the way at the end of the hallway": at its end
 ON_THE_WALL = re.compile(r"\s+(?:attached|fixed|fastened|mounted|screwed|bolted|pinned|stuck)\s+(?:to|on|onto)\s+"
-                         r"the\s+wall\b|\s+all the way(?=\s)")
+                         r"the\s+wall\b|\s+all the way(?=\s)|\s+(?:along|lining)\s+the\s+walls?\b")
 # "to the left when you enter the kitchen": the room entered is the one it is in
 ON_ENTERING = re.compile(r"\s+(?:as|when|once|after)\s+you\s+(?:enter|come in(?:to)?|walk in(?:to)?|go in(?:to)?|step into|"
                          r"get into)\s+((?:the|a)\s+[a-z' ]+?)" + _CLAUSE_END)
@@ -564,6 +564,12 @@ SEE_IF_THERE = re.compile(r"\b(?:see|check|look|find out)\s+(?:if|whether)\s+the
 # far end of the hallway")
 END_OF_OBJECT = re.compile(r"\bat the (?:far |other )?end of (?=(?:the|a|an|my|our)\s+(?!(?:"
                            + _ROOM_ALTERNATION + r")\b))")
+# a part of an object or the floor by it, as the place to go ("go to the side of the bed", "the
+# end of the counter", "the area in front of the tv" sought a "side", an "end", an "area"): the
+# object itself (a side named left or right is a relation: "on the left side of")
+PLACE_PART = re.compile(r"\b(to|towards|toward)\s+the\s+(?:area|space|side|end|front|back|edge|floor)\s+"
+                        r"(?:(?:right\s+|just\s+)?(?:in front of|next to|beside|by|near|behind)\s+|of\s+)"
+                        r"(?=(?:the|a|an|my|our|your)\s+(?!(?:" + _ROOM_ALTERNATION + r")\b))")
 # "the nearest chair to the window": the chair nearest to it (the window was read as the target)
 NEAREST_TO = re.compile(r"\b(nearest|closest)\s+([a-z]+(?:\s+[a-z]+)?)\s+to\s+(?=(?:the|a|an|my|our)\b)")
 # how much the speaker prefers what follows: "a TV, preferably in the bedroom"
@@ -1595,6 +1601,7 @@ def _rewrite_text(text: str) -> str:
         text = said
     text = THING_FOR.sub(lambda m: "the " + _need_name(m.group(1)), text)
     text = END_OF_OBJECT.sub("next to ", text)
+    text = PLACE_PART.sub(r"\1 the ", text).replace("the the ", "the ")
     text = QUESTION_TAIL.sub("", text)
     text = ON_TOP.sub("on it", text)
     text = GENERIC_THING.sub(r"\1one", text)

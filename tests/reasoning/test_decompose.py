@@ -1388,3 +1388,19 @@ def test_contractions_without_apostrophes_habits_of_others_and_states(parser, te
     assert task.targets == (target,)
     assert task.relations == relations
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # a part of the object or the floor by it as the place to go ("side", "end", "area", "front")
+    ("Head to the side of the bed.", "bed", ()),
+    ("Go to the end of the counter.", "counter_top", ()),
+    ("go to the area in front of the tv", "tv", ()),
+    ("Go to the front of the fridge.", "fridge", ()),
+    ("the painting on the left side of the bed", "painting", (("painting", "left of", "bed"),)),  # a relation
+    # along the wall ("along_wall" was the target)
+    ("find the bookshelf along the wall in the study", "shelving_unit", (("shelving_unit", "in", "office"),)),
+])
+def test_a_part_of_the_object_as_the_place_to_go_and_along_the_wall(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
