@@ -427,6 +427,10 @@ def test_household_names_people_use_map_to_the_category(parser, name, label) -> 
     ("torchiere", "floor_lamp"), ("task lamp", "desk_lamp"), ("percolator", "coffee_machine"),
     ("highboy", "dresser"), ("wristwatch", "watch"), ("wine glass", "cup"), ("doormat", "rug"),
     ("key ring", "key_chain"), ("salt", "salt_shaker"), ("t.v.", "tv"), ("w.c.", "toilet"),
+    # stop 48's round (kept as labels no detector gives, or another category)
+    ("davenport", "sofa"), ("La-Z-Boy", "armchair"), ("hassock", "ottoman"), ("boob tube", "tv"),
+    ("crib", "bed"), ("banker's lamp", "desk_lamp"), ("console table", "side_table"), ("armoire", "dresser"),
+    ("vanity", "sink"), ("fridge-freezer", "fridge"),
 ])
 def test_names_of_the_target_categories_no_table_held(parser, name, label) -> None:
     # names people give the categories that the synonym table lacked and the embedder mapped to
