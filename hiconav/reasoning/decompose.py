@@ -352,7 +352,7 @@ i'm after|i am after|we're after|seek out|do you know where|any idea where|do yo
 can you point me to|point me to|looking for|need|would love to find|would love to|got|anyone seen|has anyone seen|
 i can't find|i cannot find|i can not find|navigate toward|head toward|move toward|walk toward|go toward|where might i find|where could i find|
 take a look at|take a peek at|take a quick look at|have a peek at|have a quick look at|check out|inspect|
-go get|go grab|go fetch|i'm going to go to|i am going to go to|i'm gonna go to|i am gonna go to|i'm going to|
+go get|go grab|go fetch|make haste to|hasten to|i'm going to go to|i am going to go to|i'm gonna go to|i am gonna go to|i'm going to|
 i'm gonna go|
 park at|park by|park next to|park beside|park near|park in front of|park|pull up to|pull up next to|pull up at|
 pull up beside|pull up by|pull up in front of|pull over by|pull over next to|pull over at|pull in next to|
@@ -396,6 +396,8 @@ LEAD_IN = re.compile(
     r"(?:\s+(?:so|then|um|uh|now|well))*\s*(?:,\s*|$)|"
     r"(?:so\s+|um\s+|okay\s+|ok\s+)*(?:i was wondering if you could|i'd appreciate it if you could|"
     r"i would appreciate it if you could|would you mind|would you be so kind as to|do you know where|"
+    r"(?:i'd|i would|i'll|i will)\s+be\s+(?:most|very|so|really|extremely|truly|ever so)\s+(?:grateful|thankful|glad|happy)"
+    r"\s+if\s+you\s+(?:could|would|can)|"
     r"i'd love it if you could|i would love it if you could|it would be great if you could|it'd be great if you could|"
     r"it would be nice if you could|i'd be grateful if you could|i would be grateful if you could|"
     r"(?:(?:hey|hi|ok|okay|alright|right)\s+)?(?:robot\s*,?\s*)?(?:here's|here is|this is)\s+(?:your|the)\s+"
@@ -456,6 +458,10 @@ INVERSE = {"next to": "next to", "near": "near", "facing": "facing", "opposite":
 KIND_FIRST = re.compile(r"^(?:among|amongst|of|out of|from)\s+(?:all\s+)?(?:the|these|those)\s+([a-z' ]+?)\s*,\s*")
 NEGATED_FIRST = re.compile(r"^not\s+(?:the|a|an|that|this)\s+([a-z' ]+?)\s+(?:in|on|at|by|next to|near|beside|under|"
                            r"above|behind|close to)\b[^,;.]*[,;.]\s*(?:but\s+|rather\s+)?(?=the one\b)")
+# "not the one by the desk, the other one near the window": the one meant is the second (the
+# negation took the relation that followed with it, and no relation was left)
+NOT_ONE_BUT = re.compile(r"\bnot\s+(?:the|that)\s+one\s+[^,;.!?]*?\s*[,;]?\s+(?:but\s+|rather\s+|instead\s+)?"
+                         r"(?:the|that)\s+(?:other\s+)?one\b")
 # "make sure it's the one by the fridge", "specifically the one ...", "you know, the one ...":
 # words that insist name no object
 INSIST = re.compile(r"\b(?:make sure|be sure|ensure)\s+(?:that\s+)?(?=it|it's|its)|\b(?:specifically|namely|"
@@ -1638,6 +1644,7 @@ def _rewrite_text(text: str) -> str:
     text = SEEN_BEFORE.sub("", EGO_ROOM.sub("", text))
     text = ON_ENTERING.sub(r" in \1", ON_THE_WALL.sub("", text))
     text = CLOSER_THAN.sub(r"near \1", FAR_FROM.sub("", ITS_SIDE.sub("", HABIT.sub(" ", text))))
+    text = NOT_ONE_BUT.sub("the one", text)
     for first in (KIND_FIRST, NEGATED_FIRST):
         m = first.match(text)
         if m and re.search(r"\bthe one\b", text[m.end():]):

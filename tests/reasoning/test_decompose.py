@@ -1408,3 +1408,20 @@ def test_a_part_of_the_object_as_the_place_to_go_and_along_the_wall(parser, text
     task = parser.parse(text)
     assert task.targets == (target,)
     assert task.relations == relations
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # not one, but the other: the relation of the second was lost with the negation
+    ("Go to the chair. Not the one by the desk, the other one near the window.", "chair",
+     (("chair", "near", "window"),)),
+    ("Go to the chair, not the one by the desk but the one near the window.", "chair", (("chair", "near", "window"),)),
+    # formal lead-ins ("i", "would", "most", "grateful", ... and "make", "haste" were words of the target)
+    ("I would be most grateful if you could find the bed beneath the framed picture.", "bed",
+     (("bed", "under", "painting"),)),
+    ("Make haste to the commode adjacent to the bath.", "toilet", (("toilet", "next to", "bathtub"),)),
+])
+def test_not_one_but_the_other_and_formal_lead_ins(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert target not in task.attributes
