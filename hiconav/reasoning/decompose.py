@@ -516,7 +516,22 @@ EGO_ROOM = re.compile(r"\s+(?:in|inside|within)\s+(?:the\s+(?:next|other|adjacen
                       r"(?:to|on) your (?:left|right)|behind you|ahead|in front of you|at the end of the hall(?:way)?))\b")
 SEEN_BEFORE = re.compile(r"\s+(?:that\s+|which\s+)?(?:you|we|i)\s+(?:saw|passed|have seen|'ve seen|noticed|found|walked past|"
                          r"went past|came across|spotted|just saw|saw before)(?:\s+(?:earlier|before|just now|a moment ago|"
-                         r"on the way|already|a minute ago))?\b")
+                         r"on the way|already|a minute ago))?\b"
+                         # what someone did there before ("the bed I slept in last night" read a relation
+                         # in "last_night"; "the chair I was sitting on earlier" a "chair_i" on "earlier")
+                         r"|\s+(?:that\s+|which\s+)?(?:you|we|i|he|she|they|mom|dad)\s+(?:was\s+|were\s+|had\s+)?"
+                         r"(?:slept|sat|sitting|used|using|lay|lying|napped|napping|worked|working|reading|read|left|put|"
+                         r"dropped)(?:\s+(?:in|on|at|by))?(?:\s+(?:last night|earlier|yesterday|this morning|before|just now|"
+                         r"a while ago|a moment ago|a minute ago|today|the other day))?" + _CLAUSE_END +
+                         r"|\s+(?:that\s+|which\s+)?(?:you|we|i|he|she|they|mom|dad)\s+(?:left|put|dropped|placed|set)\s+"
+                         r"(?:my|our|your|his|her|their|the|a)\s+[a-z]+\s+(?:on|in|by|next to|under)" + _CLAUSE_END +
+                         r"|\bwhere\s+(?:you|i|we)\s+(?:last\s+)?(?:saw|found|spotted|noticed)\s+(?=(?:the|a|an|my|our|your)\b)")
+# a storey, or which one counted from a side ("on the second floor" read an object "second_floor";
+# "the stool second from the left" a "stool_second"): nothing a map of one floor can check
+STOREY_ORDINAL = re.compile(r"\s+(?:on|at)\s+the\s+(?:first|second|third|ground|top|upper|lower|main|1st|2nd|3rd)"
+                            r"\s+(?:floor|storey|story|level)\b|\s+(?:that\s+is\s+|that's\s+|which\s+is\s+)?"
+                            r"(?:first|second|third|fourth|last|1st|2nd|3rd|4th)\s+from\s+the\s+(?:left|right|end|front|back|"
+                            r"window|door|wall)\b|(?<=\bthat's)\s+both\b|(?<=\bthat is)\s+both\b|(?<=\bwhich is)\s+both\b")
 # the kind a corrected "the one ..." is of: the first object said with a relation before the correction
 KIND_BEFORE = re.compile(r"\b(?:the|a|an)\s+([a-z' ]+?)\s+(?:next to|near|by|beside|in|on|under|above|below|behind|"
                          r"close to|opposite|facing|at|in front of)\b")
@@ -1641,7 +1656,7 @@ def _rewrite_text(text: str) -> str:
     # nor do thanks or haste at the end ("find the bed thx", "go to the sofa asap")
     text = FINAL_COMMAND.sub("", AFTERWARDS.sub("", THATS_IT.sub("", text)))
     text = GOAL_PREDICATE.sub("", INSIST.sub(" ", ASIDE.sub(" ", text)))
-    text = SEEN_BEFORE.sub("", EGO_ROOM.sub("", text))
+    text = STOREY_ORDINAL.sub("", SEEN_BEFORE.sub("", EGO_ROOM.sub("", text)))
     text = ON_ENTERING.sub(r" in \1", ON_THE_WALL.sub("", text))
     text = CLOSER_THAN.sub(r"near \1", FAR_FROM.sub("", ITS_SIDE.sub("", HABIT.sub(" ", text))))
     text = NOT_ONE_BUT.sub("the one", text)

@@ -1425,3 +1425,22 @@ def test_not_one_but_the_other_and_formal_lead_ins(parser, text, target, relatio
     assert task.targets == (target,)
     assert task.relations == relations
     assert target not in task.attributes
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # what someone did there before ("last_night", "earlier" were related objects; "chair_i" the target)
+    ("Take me to the bed I slept in last night.", "bed", ()),
+    ("Find the chair I was sitting on earlier.", "chair", ()),
+    ("the chair I left my bag on", "chair", ()),
+    ("Go back to where you saw the fridge.", "fridge", ()),
+    # a storey, which one counted from a side, "both" ("second_floor", "stool_second", "chair_both")
+    ("Go to the toilet on the second floor.", "toilet", ()),
+    ("Go to the stool that is second from the left at the counter.", "stool", (("stool", "at", "counter_top"),)),
+    ("Find the chair that's both near the table and by the window.", "chair",
+     (("chair", "near", "dining_table"), ("chair", "next to", "window"))),
+])
+def test_what_was_done_there_before_storeys_and_counting_from_a_side(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert task.relations == relations
+    assert not task.attributes
