@@ -352,7 +352,9 @@ i'm after|i am after|we're after|seek out|do you know where|any idea where|do yo
 can you point me to|point me to|looking for|need|would love to find|would love to|got|anyone seen|has anyone seen|
 i can't find|i cannot find|i can not find|navigate toward|head toward|move toward|walk toward|go toward|where might i find|where could i find|
 take a look at|take a peek at|take a quick look at|have a peek at|have a quick look at|check out|inspect|
-go get|go grab|go fetch|make haste to|hasten to|i'm going to go to|i am going to go to|i'm gonna go to|i am gonna go to|i'm going to|
+go get|go grab|go fetch|lead on to|can we go see|can we go to|could we go to|could we go see|can we see|
+shall we go to|let's go see|let's go to|lemme see|let me see|gimme|give me|show me where i can find|
+make haste to|hasten to|i'm going to go to|i am going to go to|i'm gonna go to|i am gonna go to|i'm going to|
 i'm gonna go|
 park at|park by|park next to|park beside|park near|park in front of|park|pull up to|pull up next to|pull up at|
 pull up beside|pull up by|pull up in front of|pull over by|pull over next to|pull over at|pull in next to|
@@ -375,6 +377,8 @@ i'd like to be taken to|i would like to be taken to|i want to be taken to|i need
 # how a last clause joins what it follows: ", and then please ...", ". ...", "; ..."
 _LAST_CLAUSE = r"(?:,?\s+(?:and|then|and then)\s+|,\s*|[.!;]\s*)(?:please\s+)?"
 FINAL_COMMAND = re.compile(
+    # a chore on the object already named ("go to the tv and turn it on" sought a second "turn")
+    _LAST_CLAUSE + r"(?:turn|switch|power)\s+(?:it|them)\s+(?:on|off|up|down)(?:\s+please)?\s*[.!]*\s*$|" +
     _LAST_CLAUSE + r"(?:stop|wait|stay|halt|remain)"
     r"(?:\s+(?:there|here|next to it|by it|in front of it|beside it|when you get there|when you arrive|"
     r"once you are there|once you get there|"
@@ -391,7 +395,7 @@ AFTERWARDS = re.compile(
 LEAD_IN = re.compile(
     r"^(?:(?:if you (?:don't|do not) mind|when you (?:get|have) (?:a|the) (?:chance|moment|minute|second)|"
     r"whenever you can|if you can|if possible|when you can|at your convenience|when you're ready|"
-    r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh|please|yo|hey|i beg you|"
+    r"when you are ready|look|listen|see|right|well|okay|ok|alright|so|um|uh|hmm|oh|please|yo|hey|help|i beg you|"
     r"i'm begging you|i implore you|i ask you|i'm asking you)"
     r"(?:\s+(?:so|then|um|uh|now|well))*\s*(?:,\s*|$)|"
     r"(?:so\s+|um\s+|okay\s+|ok\s+)*(?:i was wondering if you could|i'd appreciate it if you could|"
@@ -654,7 +658,7 @@ NEED_ASK = re.compile(
     r"(?:somewhere|something|a place|a spot|anywhere|a good (?:place|spot))(?: (?:comfy|comfortable|nice|good|quiet|warm))?"
     r"(?: (?:where|so) (?:i|we) can| (?:i|we) can| to| for)?|(?:i|we) (?:really |seriously |desperately )?"
     r"(?:need|want|would like|'d like|have|got) to|(?:i|we) (?:really )?gotta|"
-    r"(?:i|we) (?:need|want) (?:somewhere|something|a place) to|(?:somewhere|something|a place|a spot)"
+    r"(?:i|we) (?:need|want) (?:somewhere|something|a place) to|let's|let us|let me|(?:somewhere|something|a place|a spot)"
     r"(?: to| (?:where )?(?:i|we) can)|(?:i|we) (?:really )?(?:need|have to use|need to use))\s+"
     r"(?P<need>" + "|".join(f"(?:{need})" for need, _ in NEEDS) + r")\b(?P<rest>[a-z' ]*)$")
 
@@ -673,7 +677,7 @@ def _need_object(part: str) -> str | None:
     rest = re.sub(r"^\s+and\s+[a-z']+(?:\s+[a-z']+)?$", "", m.group("rest"))  # "sit down and read"
     room = re.fullmatch(r"\s+(?:in|at)\s+(?:the|my|our)\s+[a-z' ]*\b(?:room|kitchen|bedroom|bathroom|hall|hallway|"
                         r"lounge|office|study)", rest)
-    if room is None and rest.strip() and not re.fullmatch(r"\s*(?:on|in|at|with|please|now|here)?\s*", rest):
+    if room is None and rest.strip() and not re.fullmatch(r"\s*(?:on|in|at|with|please|now|here|somewhere|anywhere|for a bit|for a while)?\s*", rest):
         return None  # "I want to sit on the sofa" names its object: ACTIVITY's rule
     name = _need_name(m.group("need"))
     return f"find the {name}" + (room.group(0) if room is not None else "")
@@ -1622,6 +1626,7 @@ def _rewrite_text(text: str) -> str:
     text = NEAREST_TO.sub(r"\2 \1 to ", text)
     text = WHERE_DID_PUT.sub("find ", WHERE_DID_GO.sub(r"find \1", text))
     text = MOTION_ADVERB.sub(r"\1 ", text)
+    text = re.sub(r"\bto\s+wherever\s+((?:the|a|an|my|our)\s+[a-z' ]+?)\s+(?:is|are|might be|may be)\b", r"to \1", text)
     if (said := URGENCY.sub("", text)) != text and re.search(r"[a-z]", said):
         text = said
     text = THING_FOR.sub(lambda m: "the " + _need_name(m.group(1)), text)

@@ -1444,3 +1444,21 @@ def test_what_was_done_there_before_storeys_and_counting_from_a_side(parser, tex
     assert task.targets == (target,)
     assert task.relations == relations
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,target", [
+    ("Lead on to the dresser.", "dresser"),  # a "lead" on the dresser
+    ("Bring me over to wherever the toaster is.", "toaster"),  # "wherever" a word of the toaster
+    ("Can we go see the statue?", "statue"),
+    ("Lemme see the TV.", "tv"),
+    ("gimme the laptop", "laptop"),
+    ("show me where I can find a tv", "tv"),
+    ("Go to the tv and turn it on.", "tv"),  # a second target "turn"
+    ("Help, where's the toilet?", "toilet"),  # a target "help"
+    ("Let's make coffee.", "coffee_machine"),  # a "make_coffee"
+    ("Let me sit down somewhere.", "chair"),  # a "me_down"
+])
+def test_casual_lead_ins_a_chore_on_the_object_named_and_lets(parser, text, target) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert not task.attributes
