@@ -30,6 +30,7 @@ from hiconav.messages import (
     NavStatus,
     ParseRequest,
     PlanMsg,
+    RuledOut,
     StopRequest,
     TargetRejected,
     TaskMsg,
@@ -79,6 +80,7 @@ class MissionNode(Node):
         self.on(HypothesisMsg, lambda m, now: self.context.hypotheses.append(m.hypothesis))
         self.on(NavStatus, self._on_nav)
         self.on(HealthAlert, lambda m, now: self.context.alerts.append(m))
+        self.on(RuledOut, lambda m, now: setattr(self.context, "ruled_out", frozenset(m.object_ids)))
         self.on(EpisodeEnded, lambda m, now: setattr(self, "episode", m))
 
     def _on_nav(self, msg: NavStatus, now: float) -> None:

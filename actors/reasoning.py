@@ -127,7 +127,7 @@ class ReasoningNode(Node):
         ruled_out = frozenset(i for i, v in self.verdicts.items() if v == "fails")
         if ruled_out != self._ruled_out:
             self._ruled_out = ruled_out
-            self.emit("exploration", RuledOut(ruled_out, now + delay), delay)
+            self.emit(("exploration", "mission"), RuledOut(ruled_out, now + delay), delay)
 
     def tick(self, now: float) -> None:
         if now < self.busy_until - 1e-9:

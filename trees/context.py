@@ -128,6 +128,10 @@ class MissionContext:
     # made there (look_turns at most per spot, for the whole mission)
     look_spot: tuple[float, float] | None = None
     looks_here: int = 0
+    # the target-category nodes the reasoning layer rules out (RuledOut, latest wins) and those
+    # Explore has lingered by (``decisions.linger``)
+    ruled_out: frozenset[int] = frozenset()
+    lingered: set[int] = field(default_factory=set)
 
     # -- time and pose -------------------------------------------------------------------------
     def now(self) -> float:

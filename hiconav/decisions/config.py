@@ -73,6 +73,11 @@ class ExploreSettings(_Section):
                              "navigator's thinner masks before giving up")
     unresolved_asks: int = _f(3, "explored out in search of a described instance, ask the reasoning layer this "
                                  "many times for its best unresolved candidate before failing", 0, 100)
+    linger_turns: int = _f(4, "quarter turns in place beside an undecided instance of the target's category "
+                              "that a described-instance search comes upon (hiconav.decisions.linger; 0: never)",
+                           0, 100)
+    linger_m: float = _f(1.5, "an instance within this of the robot's footprint distance is close enough to "
+                              "linger by (m)", 0.0, 10.0)
     last_resort: bool = _f(True, "explored out with a candidate set aside only as out of reach (no view point or "
                                  "approach cell it could reach): stop as near the best of it as the map allows "
                                  "rather than fail (hiconav.decisions.last_resort)")

@@ -1596,3 +1596,28 @@ def test_a_later_rejection_on_evidence_clears_out_of_reach_and_a_last_resort_is_
     # rejected again (the approach timed out): it is no candidate any more
     ctx.reject(4, "approach: timed out", permanent=True)
     assert ctx.last_resort is None and ctx.excluded(4) and not ctx.candidates()
+
+
+def test_explore_turns_beside_an_undecided_described_instance_once_then_explores_on(tmp_path):
+    """A described-instance search that comes upon an armchair 0.5 m off, which the reasoning layer
+    has not ruled out, turns in place beside it (linger_turns quarter turns, once per node)
+    before following the plan again; an armchair ruled out, or a plain object goal, does not."""
+    described = TaskSpec("the armchair next to the floor lamp", ("armchair",), ("floor_lamp",),
+                         relations=(("armchair", "next to", "floor_lamp"),))
+    for ruled_out, task, lingers in ((frozenset(), described, True), (frozenset({3}), described, False),
+                                     (frozenset(), TaskSpec("find the armchair", ("armchair",)), False)):
+        clock = Clock()
+        ctx = _ctx(clock)
+        ctx.task, ctx.ruled_out = task, ruled_out
+        ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "armchair", 3.0, 2.0)])
+        ctx.plan = plan((8.0, 8.0))
+        tree = MissionTree(_write(tmp_path, "root:\n  Explore: {linger_turns: 2}\n"), ctx)
+        kinds = []
+        for _ in range(4):
+            clock.t += 0.5
+            tree.tick()
+            goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+            kinds.append(goal.goal.kind)
+            ctx.nav = NavStatus(goal.seq, "reached", 0.0)
+        assert (kinds[:2] == ["look", "look"] and kinds[2] != "look") is lingers, kinds
+        assert (3 in ctx.lingered) is lingers

@@ -8,7 +8,8 @@ pose, the state of the goal in flight, the mission's record of exploration), ask
 
 from __future__ import annotations
 
-from hiconav.decisions.frontiers import ExploreLedger, FrontierFollower, FrontierGoal, PlanView
+from hiconav.decisions import linger
+from hiconav.decisions.frontiers import ExploreLedger, FrontierFollower, FrontierGoal, PlanView, look_goal
 from hiconav.trees.behaviours.base import MissionBehaviour, Status
 from hiconav.trees.registry import register_behaviour
 from hiconav.types import Goal
@@ -36,9 +37,12 @@ class Explore(MissionBehaviour):
         if self.context.last_frontier_time is None:
             self.context.last_frontier_time = self.context.now()
         self._follower = FrontierFollower()
+        self._lingering: int | None = None  # the node Explore turns beside (``decisions.linger``)
 
     def update(self) -> Status:
         ctx = self.context
+        if self._linger():
+            return Status.RUNNING
         ledger = ExploreLedger(ctx.last_frontier_time, ctx.start_looks, ctx.look_spot, ctx.looks_here,
                                ctx.spent_viewpoints, ctx.pushed_frontiers, ctx.failed_frontiers,
                                ctx.squeezed_frontiers, self._asks_left(), int(ctx.stranded))
@@ -64,6 +68,34 @@ class Explore(MissionBehaviour):
             ctx.take_last_resort()  # the next tick's TargetConfirmed takes it up
         self.feedback_message = step.feedback
         return Status.FAILURE if step.status == "failure" else Status.RUNNING
+
+    def _linger(self) -> bool:
+        """Turn in place beside an undecided instance of a described target's category come upon
+        close by (``linger.undecided_near``), ``linger_turns`` quarter turns once per instance, then
+        explore on afresh: True while turning."""
+        ctx, s, pose = self.context, self.settings, self.context.pose
+        if self._lingering is not None:
+            if ctx.nav_state(self._seq) not in ("reached", "failed"):
+                return True
+            self._turns += 1
+            if self._turns < s.linger_turns:
+                self._seq = ctx.send_goal(_goal(look_goal(pose)))
+                return True
+            self._lingering, self._seq, self._follower = None, None, FrontierFollower()
+            return False
+        if (s.linger_turns <= 0 or pose is None or ctx.memory is None or not (ctx.reasoning and ctx.described)
+                or ctx.start_looks < s.start_look_turns):
+            return False
+        oid = linger.undecided_near(ctx.memory.objects, ctx.task.targets, (pose.x, pose.y), s.linger_m,
+                                    ctx.ruled_out, ctx.lingered, ctx.excluded)
+        if oid is None:
+            return False
+        ctx.lingered.add(oid)
+        ctx.log(f"Explore: turning beside undecided #{oid}")
+        self._lingering, self._turns, ctx.last_frontier_time = oid, 0, ctx.now()
+        self._seq = ctx.send_goal(_goal(look_goal(pose)))
+        self.feedback_message = f"looking around #{oid}"
+        return True
 
     def _asks_left(self) -> int:
         """Asks for an unresolved candidate left: only a described instance that the reasoning
