@@ -45,3 +45,15 @@ class Anchor:
 class Memory:
     objects: list
     anchors: list = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Node:
+    """A memory object node: its id, label, 3D box (world m), confidence and observations."""
+
+    id: int
+    label: str
+    box_min: np.ndarray
+    box_max: np.ndarray
+    confidence: float = 0.9
+    n_obs: int = 1

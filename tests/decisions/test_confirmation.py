@@ -3,7 +3,6 @@ anchors: which nodes support a candidate, which frames count, and the verdicts t
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -11,21 +10,11 @@ from hiconav.decisions import confirmation as conf
 from hiconav.decisions.config import VerifySettings
 from hiconav.types import Pose2D, camera_pose_from_base
 
-from .fakes import Anchor
+from .fakes import Anchor, Node
 
 S = VerifySettings(min_fresh_views=2, max_view_frames=8, unseen_view_frames=4)
 CENTRE = np.array([5.0, 5.0, 0.4])
 LO, HI = CENTRE - [0.5, 0.5, 0.4], CENTRE + [0.5, 0.5, 0.4]
-
-
-@dataclass(frozen=True)
-class Node:
-    id: int
-    label: str
-    box_min: np.ndarray
-    box_max: np.ndarray
-    confidence: float = 0.9
-    n_obs: int = 1
 
 
 def node(oid: int, label: str, x: float, y: float, confidence: float = 0.9, n_obs: int = 1) -> Node:

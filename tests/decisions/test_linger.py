@@ -2,19 +2,11 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from hiconav.decisions import linger
 
-
-@dataclass(frozen=True)
-class Node:
-    id: int
-    label: str
-    box_min: np.ndarray
-    box_max: np.ndarray
+from .fakes import Node
 
 
 def node(oid: int, label: str, x: float, y: float, half: float = 0.3) -> Node:
