@@ -231,19 +231,19 @@ def sight_of(settings: VerifySettings, memory: Any, task_targets: Iterable[str] 
     return sight(cand.center, camera_of(memory), hiding(settings, memory, task_targets, cand))
 
 
-def view_here(settings: VerifySettings, pose: Any, grid: Any, memory: Any, task_targets: Iterable[str] | None,
-              cand: Any, ring: float, gap: float, excluded: Iterable[np.ndarray] = ()) -> np.ndarray | None:
+def view_here(settings: VerifySettings, pose: Any, grid: Any, cand: Any, ring: float, gap: float,
+              camera: tuple[float, float] | None, rules: dict, excluded: Iterable[np.ndarray] = ()) -> np.ndarray | None:
     """The robot's own place (world xy) as the view cell of the candidate ``cand``, ``gap`` m from
     its footprint, when ``from_here`` is set and ``viewing.views_from_here`` holds there (within
-    the view ``ring``, in sight past the boxes that may hide it and past walls); else None."""
+    the view ``ring``, in sight past the boxes that may hide it and past walls). ``rules``: the
+    view cell search's ``sight``, ``furniture`` and ``wall_heights`` (``cell_near``'s keywords),
+    read as that search reads them; else None."""
     if not settings.from_here or pose is None or grid is None:
         return None
     here = np.array([float(pose.x), float(pose.y)])
-    box = (np.asarray(cand.box_min), np.asarray(cand.box_max))
-    ok = views_from_here(settings, here, gap, ring, np.asarray(cand.center, dtype=np.float64), camera_of(memory),
-                         sight_of(settings, memory, task_targets, cand), grid,
-                         [box, *furniture_boxes(memory, cand.object_id)], wall_heights(memory, float(box[1][2])),
-                         excluded)
+    explained = [(np.asarray(cand.box_min), np.asarray(cand.box_max)), *(rules.get("furniture") or ())]
+    ok = views_from_here(settings, here, gap, ring, np.asarray(cand.center, dtype=np.float64), camera,
+                         rules.get("sight"), grid, explained, rules.get("wall_heights"), excluded)
     return here if ok else None
 
 

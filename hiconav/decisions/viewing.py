@@ -54,16 +54,14 @@ def view_ring(settings: VerifySettings, center_z: float, camera: tuple[float, fl
     return max(base, min(nearest_view(settings, center_z, camera), settings.max_view_ring))
 
 
-def nearest_view(settings: VerifySettings, center_z: float, camera: tuple[float, float] | None,
-                 spare_deg: float | None = None) -> float:
+def nearest_view(settings: VerifySettings, center_z: float, camera: tuple[float, float] | None) -> float:
     """The nearest distance (m from the footprint) from which the camera holds an object whose
-    centre is ``center_z`` m up inside its vertical field of view with ``spare_deg`` (default
-    ``fov_spare_deg``) to spare: ``view_ring``'s need alone, never nearer than ``MIN_VIEW_RING``."""
+    centre is ``center_z`` m up inside its vertical field of view with ``fov_spare_deg`` to
+    spare: ``view_ring``'s need alone, never nearer than ``MIN_VIEW_RING``."""
     if camera is None:
         return MIN_VIEW_RING
     height, vfov = camera
-    spare = settings.fov_spare_deg if spare_deg is None else spare_deg
-    half = max(0.5 * vfov - math.radians(spare), MIN_HALF_FOV)
+    half = max(0.5 * vfov - math.radians(settings.fov_spare_deg), MIN_HALF_FOV)
     return max(abs(float(center_z) - height) / math.tan(half), MIN_VIEW_RING)
 
 

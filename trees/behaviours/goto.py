@@ -45,9 +45,10 @@ class _GoToObject(MissionBehaviour):
         """A point the approach cell should lie near, or None (no preference)."""
         return None
 
-    def _here(self, cand: Candidate, distance: float) -> np.ndarray | None:
+    def _here(self, cand: Candidate, distance: float, rules: dict) -> np.ndarray | None:
         """Where the robot stands (world xy) when that will do for a cell within ``distance`` of
-        the candidate (see VerifyTarget), else None: a cell is searched."""
+        the candidate under ``rules`` (``_send``'s, as ``cell_near`` takes them; see VerifyTarget),
+        else None: a cell is searched."""
         return None
 
     def _sight(self, cand: Candidate) -> tuple[np.ndarray, float, np.ndarray, np.ndarray] | None:
@@ -73,7 +74,7 @@ class _GoToObject(MissionBehaviour):
                  "prefer_weight": self._prefer_weight(), "sight": self._sight(cand),
                  "furniture": self._furniture(cand), "strict_walls": strict_walls, "box_weight": box_weight,
                  "wall_heights": self._wall_heights(cand), "corner_radius": self._corner_radius()}
-        here = self._here(cand, distance)
+        here = self._here(cand, distance, rules)
         if here is not None:
             self._go_to_cell(cand, here, 0.2)
             return True

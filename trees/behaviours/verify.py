@@ -49,10 +49,10 @@ class VerifyTarget(_GoToObject):
     def _preferred_xy(self, cand: Candidate, distance: float) -> np.ndarray | None:
         return view.seen_from_node(cand.center, self.context.memory, self.context.object(cand.object_id), distance)
 
-    def _here(self, cand: Candidate, distance: float) -> np.ndarray | None:
+    def _here(self, cand: Candidate, distance: float, rules: dict) -> np.ndarray | None:
         ctx = self.context
-        return verif.view_here(self.settings, ctx.pose, ctx.grid, ctx.memory, self._targets(), cand, distance,
-                               ctx.distance_to_box(cand.box_min, cand.box_max), self._excluded)
+        return verif.view_here(self.settings, ctx.pose, ctx.grid, cand, distance,
+                               ctx.distance_to_box(cand.box_min, cand.box_max), self._camera(), rules, self._excluded)
 
     def _ring(self, cand: Candidate) -> float:
         return view.view_ring(self.settings, float(np.asarray(cand.center)[2]), self._camera())
