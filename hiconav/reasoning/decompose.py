@@ -565,6 +565,8 @@ WHERE_DID_GO = re.compile(r"\bwhere did ((?:the|my|our|your)\s+[a-z' ]+?)\s+go\b
 # "where did I leave my laptop?": asks for the laptop (a "where_did_i_leave" was read on it)
 WHERE_DID_PUT = re.compile(r"\bwhere did (?:i|we|you|he|she|they|mom|dad)\s+(?:last\s+)?(?:leave|put|drop|see|stash|"
                            r"hide|park|set)\s+(?=(?:the|my|our|your|his|her|their)\b)")
+# "bring me over to wherever the toaster is": to the toaster ("wherever" was a word of it)
+WHEREVER = re.compile(r"\bto\s+wherever\s+((?:the|a|an|my|our)\s+[a-z' ]+?)\s+(?:is|are|might be|may be)\b")
 # how the robot is to move there ("go straight to the sofa", "move forward to the dresser" read
 # "to" and "move forward to" as words of the sofa and the dresser)
 MOTION_ADVERB = re.compile(r"\b(go|head|move|drive|walk|run|come|navigate|proceed|travel|roll|get)\s+(?:straight ahead|"
@@ -1626,12 +1628,12 @@ def _rewrite_text(text: str) -> str:
     text = NEAREST_TO.sub(r"\2 \1 to ", text)
     text = WHERE_DID_PUT.sub("find ", WHERE_DID_GO.sub(r"find \1", text))
     text = MOTION_ADVERB.sub(r"\1 ", text)
-    text = re.sub(r"\bto\s+wherever\s+((?:the|a|an|my|our)\s+[a-z' ]+?)\s+(?:is|are|might be|may be)\b", r"to \1", text)
+    text = WHEREVER.sub(r"to \1", text)
     if (said := URGENCY.sub("", text)) != text and re.search(r"[a-z]", said):
         text = said
     text = THING_FOR.sub(lambda m: "the " + _need_name(m.group(1)), text)
     text = END_OF_OBJECT.sub("next to ", text)
-    text = PLACE_PART.sub(r"\1 the ", text).replace("the the ", "the ")
+    text = PLACE_PART.sub(r"\1 ", text)
     text = QUESTION_TAIL.sub("", text)
     text = ON_TOP.sub("on it", text)
     text = GENERIC_THING.sub(r"\1one", text)
