@@ -1646,11 +1646,16 @@ def _rewrite_text(text: str) -> str:
     text = MISSION_ASIDE.sub(" ", text)
     for form, said in FIELDS:
         text = form.sub(said, text)
-    text = re.sub(r"[\"“”()\[\]{}:]", " ", text)
+    # an aside in brackets is a field of its own ("bed (bedroom 2, next to the window)"), not
+    # words run into the name before it (which read a "bed_bedroom")
+    text = re.sub(r"\s*[()\[\]{}]\s*", " , ", text)
+    text = re.sub(r"[\"“”:]", " ", text)
     text = PLACE_OF.sub("", WHERE_YOU_FIND.sub(". find ", text))
     text = HAS_GOT.sub(" has", HEDGED_BE.sub(" ", text))
     # "the chair & the table", "chair+sofa": and; "chair/sofa": or
-    text = re.sub(r"\s*[&+]\s*", " and ", re.sub(r"(?<=[a-z])/(?=[a-z])", " or ", text))
+    # "chair / kitchen / near fridge", spaced, reads as "or" too: a room or a relation among the
+    # alternatives is read as where the object is
+    text = re.sub(r"\s*[&+]\s*", " and ", re.sub(r"(?<=[a-z])\s*/\s*(?=[a-z])", " or ", text))
     # a dash with space around it, or an en / em dash, parts clauses ("the plant in the
     # kitchen - go there"); a hyphen inside a word ("t-shirt") does not
     text = re.sub(r"\s[-\u2013\u2014]+\s|[\u2013\u2014]+", " ; ", text)

@@ -1462,3 +1462,23 @@ def test_casual_lead_ins_a_chore_on_the_object_named_and_lets(parser, text, targ
     task = parser.parse(text)
     assert task.targets == (target,)
     assert not task.attributes
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    # a bracketed aside is a field of its own (a "bed_bedroom", a "chair_kitchen" were the targets)
+    ("bed (bedroom 2, next to the window)", "bed", {("bed", "next to", "window"), ("bed", "in", "bedroom")}),
+    ("find the tv (living room)", "tv", {("tv", "in", "living_room")}),
+    ("find the bed [bedroom]", "bed", {("bed", "in", "bedroom")}),
+    ("find the chair (near the fridge) in the kitchen", "chair", {("chair", "near", "fridge"), ("chair", "in", "kitchen")}),
+    ("find the bed (please)", "bed", set()),
+    # a spaced slash parts fields as an unspaced one does
+    ("chair / kitchen / near fridge", "chair", {("chair", "near", "fridge"), ("chair", "in", "kitchen")}),
+])
+def test_fields_in_brackets_and_between_spaced_slashes(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,)
+    assert set(task.relations) == relations and not task.attributes
+
+
+def test_alternatives_between_spaced_slashes_are_either(parser) -> None:
+    assert parser.parse("chair / sofa").targets == parser.parse("chair/sofa").targets == ("chair", "sofa")
