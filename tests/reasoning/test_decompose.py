@@ -1482,3 +1482,17 @@ def test_fields_in_brackets_and_between_spaced_slashes(parser, text, target, rel
 
 def test_alternatives_between_spaced_slashes_are_either(parser) -> None:
     assert parser.parse("chair / sofa").targets == parser.parse("chair/sofa").targets == ("chair", "sofa")
+
+
+@pytest.mark.parametrize("text,target,room", [
+    ("tv living room", "tv", "living_room"),  # the room was the target
+    ("find the chair kitchen", "chair", "kitchen"),  # a "chair_kitchen"
+    ("the toilet bathroom", "toilet", "bathroom"),
+])
+def test_a_room_written_after_the_name_places_the_object(parser, text, target, room) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,) and task.relations == ((target, "in", room),)
+
+
+def test_a_name_that_ends_in_a_room_word_stays_the_name(parser) -> None:
+    assert parser.parse("find the chaise lounge").relations == ()
