@@ -653,6 +653,7 @@ NEEDS: tuple[tuple[str, str], ...] = (
      "toilet"),
     (r"take a bath|have a bath|bathe|have a soak", "bathtub"),
     (r"work|study|do (?:my |some )?homework|write", "desk"),
+    (r"eat|dine|have (?:a |my |our |some )?(?:meal|dinner|lunch|breakfast|supper)", "dining table"),
 )
 NEED_ASK = re.compile(
     r"^(?:where (?:can|do|could|should|would|may) (?:i|we)|(?:(?:i|we) (?:need|want|would like|'d like) you to )?"

@@ -1496,3 +1496,15 @@ def test_a_room_written_after_the_name_places_the_object(parser, text, target, r
 
 def test_a_name_that_ends_in_a_room_word_stays_the_name(parser) -> None:
     assert parser.parse("find the chaise lounge").relations == ()
+
+
+@pytest.mark.parametrize("text,target,relations", [
+    ("Where do we eat?", "dining_table", ()),  # a "we_eat"
+    ("where can I have dinner", "dining_table", ()),
+    ("Let's eat", "dining_table", ()),
+    ("where do we eat in the kitchen?", "dining_table", (("dining_table", "in", "kitchen"),)),
+    ("I'm hungry", "fridge", ()),  # food, not a place to eat it
+])
+def test_where_one_eats_is_the_dining_table(parser, text, target, relations) -> None:
+    task = parser.parse(text)
+    assert task.targets == (target,) and task.relations == relations
