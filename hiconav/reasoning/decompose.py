@@ -1524,16 +1524,16 @@ class OfflineParser:
             return NounPhrase("bedroom", (), text, False, room="bedroom")
         # Rooms ("the kitchen", "the master bedroom").
         for n in range(min(3, len(words)), 0, -1):
-            tail = " ".join(words[-n:])
-            if tail in ROOMS and not any(w not in ATTRIBUTE_WORDS and w not in ROOM_QUALIFIERS for w in words[:-n]):
-                return NounPhrase(ROOMS[tail], tuple(w for w in words[:-n] if w in ATTRIBUTE_WORDS), text, False,
+            tail, head = " ".join(words[-n:]), words[:-n]
+            if tail not in ROOMS:
+                continue
+            if not any(w not in ATTRIBUTE_WORDS and w not in ROOM_QUALIFIERS for w in head):
+                return NounPhrase(ROOMS[tail], tuple(w for w in head if w in ATTRIBUTE_WORDS), text, False,
                                   room=ROOMS[tail])
-        # written short, a room after the object's name places it there ("tv living room",
-        # "chair kitchen"), unless the words together are a name ("chaise lounge")
-        for n in range(min(3, len(words) - 1), 0, -1):
-            tail = " ".join(words[-n:])
-            if tail in ROOMS and self.lexicon.lookup(text) is None:
-                np_ = self._noun_phrase(words[:-n])
+            # written short, a room after the object's name places it there ("tv living room",
+            # "chair kitchen"), unless the words together are a name ("chaise lounge")
+            if self.lexicon.lookup(text) is None:
+                np_ = self._noun_phrase(head)
                 if np_ is not None and np_.room is None and np_.in_vocabulary:
                     return replace(np_, in_room=np_.in_room or ROOMS[tail])
         # a name with an attribute word in it ("toilet paper", "upholstered chair", "small
