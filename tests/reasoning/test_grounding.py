@@ -300,12 +300,14 @@ def test_a_node_observed_often_passes_the_offline_confidence_floor():
     the score is not (reasoning.offline.confident_observations)."""
     verifier = OfflineVerifier(ReasoningConfig())
     scene = _living_room_scene()
-    faint = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.25, n_obs=4,
+    faint = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.25, n_obs=2,
                  center=scene[0].center)
     assert verifier.verify(graph([faint, *scene[1:3]]), TASK).reason == "low_confidence"
-    often = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.25, n_obs=12,
+    often = Node(1, "armchair", scene[0].box_min, scene[0].box_max, (1,), confidence=0.25, n_obs=3,
                  center=scene[0].center)
     assert verifier.verify(graph([often, *scene[1:3]]), TASK).found
+    never = OfflineVerifier(ReasoningConfig(offline={"confident_observations": 0}))  # 0: the floor always holds
+    assert never.verify(graph([often, *scene[1:3]]), TASK).reason == "low_confidence"
 
 
 def test_the_described_category_gives_no_room_cue_of_its_own():
@@ -332,7 +334,7 @@ def test_a_related_object_seen_too_weakly_to_count_grounds_no_relation():
     assert result.found and result.verdicts == {1: "holds"}
     # the same sink seen once, or at a confidence a detector's false positive has: it proves
     # nothing yet, so the painting is unresolved (not ruled out) until the sink is seen again
-    for weak in (replace(sink, n_obs=1), replace(sink, confidence=0.2)):
+    for weak in (replace(sink, n_obs=1), replace(sink, confidence=0.2, n_obs=2)):
         result = verifier.verify(graph([painting, weak]), task)
         assert not result.found and result.reason == RELATION_UNKNOWN and result.verdicts == {1: "unknown"}
     # a node seen often enough passes the confidence floor, as the target's own node does

@@ -144,7 +144,7 @@ def test_offline_verifier_needs_enough_observations_and_confidence() -> None:
     task = make_task()
     few = OfflineVerifier().verify(make_subgraph(mug_obs=1), task)
     assert not few.found and few.reason == "insufficient_observations"
-    weak = OfflineVerifier().verify(make_subgraph(mug_conf=0.2), task)
+    weak = OfflineVerifier().verify(make_subgraph(mug_conf=0.2, mug_obs=2), task)
     assert not weak.found and weak.reason == "low_confidence"
 
 
