@@ -94,6 +94,8 @@ class VerifySettings(_Section):
     max_view_ring: float = _f(4.0, "the view ring widens for high or low objects up to this (m)", 0.3, 20.0)
     from_here: bool = _f(True, "a robot already standing where a view cell would (within the view ring, the "
                                "candidate in sight) judges it from there instead of driving to a view cell")
+    path_cost: bool = _f(True, "view cells are weighed by the length of the path to them on the robot's map, "
+                               "not the straight line (a cell across a bed is a walk round it)")
     close_ring_gap: float = _f(0.35, "frames are judged from at least this beyond the view ring (m)", 0.0, 5.0)
     close_margin: float = _f(0.25, "frames are judged this far beyond verify_distance or the view ring, and a "
                                    "closer cell must lie beyond that less this (m)", 0.0, 5.0)
@@ -171,6 +173,8 @@ class ApproachSettings(_Section):
     corner_radius: float = _f(0.3, "the robot's distance to the target is measured to its box with the corners rounded "
                               "by this (m, at most half the shorter side): most objects leave their box's corners "
                               "empty, so off a corner the object lies farther than the box (0: the box)", 0.0, 5.0)
+    path_cost: bool = _f(True, "approach cells are weighed by the length of the path to them on the robot's "
+                               "map, not the straight line (a cell across a table is a walk round it)")
     measure: Literal["box", "points"] = _f("box", "how far the robot is from the object: its memory box, or a "
                                                   "low quantile of its points' planar distances ('points')")
     points_quantile: float = _f(0.02, "with measure 'points', a node's points nearer than this quantile are its "

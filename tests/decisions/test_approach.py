@@ -177,3 +177,32 @@ def test_without_a_cell_a_last_resort_creeps_then_faces_and_others_face_only_wit
     assert plan.without_cell(2.0, False, False, False, s) is None  # no reachable approach cell
     assert plan.without_cell(0.5, False, False, False, s) == "face"
     assert plan.without_cell(0.5, False, True, False, s) is None
+
+
+def test_with_path_cost_the_cell_on_the_robots_side_of_furniture_wins_over_the_nearer_in_a_line():
+    """A table between the robot and the object: the straight-line nearest cell lies in the gap
+    between the table and the object, a walk round the table's end and back; by the path on the
+    map a cell off the table's end wins, within the ring all the same."""
+    table = (slice(60, 68), slice(35, 66))  # y 6.0-6.8 m, x 3.5-6.6 m: north of the object
+    grid = room(table)
+    grid.inflated = grid.state == 1
+    robot = np.array([5.0, 8.0])  # north of the table
+    line = geometry.approach_cell(grid, LO, HI, robot, 1.2)
+    path = geometry.approach_cell(grid, LO, HI, robot, 1.2, path_cost=True)
+    assert line is not None and path is not None
+    lengths = geometry.path_lengths(grid, robot, (0, 100, 0, 100))
+    res = grid.resolution
+
+    def walk(c):
+        return float(lengths[int(c[1] / res), int(c[0] / res)])
+    assert walk(path) < walk(line) - 1.0  # the line's pick is a walk round the bed
+    assert rounded_box_distance(path[0], path[1], LO, HI, 0.0) <= 1.2 + 1e-9
+
+
+def test_path_lengths_follow_the_free_cells_and_leave_walled_off_cells_unreached():
+    grid = room((slice(0, 100), slice(20, 21)))  # a wall across the room at x = 2.0 m
+    grid.inflated = grid.state == 1
+    lengths = geometry.path_lengths(grid, np.array([5.0, 1.0]), (0, 100, 0, 100), margin_m=20.0)
+    assert lengths[10, 50] == pytest.approx(0.0, abs=0.15)
+    assert lengths[10, 80] == pytest.approx(3.0, abs=0.15)  # open floor: the straight line
+    assert np.isinf(lengths[10, 10])  # behind the wall

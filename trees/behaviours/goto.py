@@ -73,7 +73,8 @@ class _GoToObject(MissionBehaviour):
         rules = {"centre_weight": self._centre_weight(), "prefer_xy": self._preferred_xy(cand, distance),
                  "prefer_weight": self._prefer_weight(), "sight": self._sight(cand),
                  "furniture": self._furniture(cand), "strict_walls": strict_walls, "box_weight": box_weight,
-                 "wall_heights": self._wall_heights(cand), "corner_radius": self._corner_radius()}
+                 "wall_heights": self._wall_heights(cand), "corner_radius": self._corner_radius(),
+                 "path_cost": bool(getattr(self.settings, "path_cost", False))}
         here = self._here(cand, distance, rules)
         if here is not None:
             self._go_to_cell(cand, here, 0.2)
