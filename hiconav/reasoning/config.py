@@ -69,7 +69,7 @@ class OfflineVerifierConfig(BaseModel):
     min_observations: int = Field(2, ge=1)  # n_obs of the object node
     # a node observed this often passes min_confidence: detectors score small and far objects low
     # in every frame, and many observations are evidence the score is not (0: never). 3 chosen on
-    # ProcTHOR train textnav seeds 0-2 (10 -> 3: SPL +0.6, +0.1, +0.5 points, no success lost):
+    # ProcTHOR train textnav seeds 0-2 (10 -> 3: SPL +0.6, +0.1, +0.5 points, SR unchanged):
     # a described instance seen three times held its verdict back while the robot drove past it
     confident_observations: int = Field(3, ge=0)
     min_similarity: float = Field(0.85, ge=0, le=1)  # label-target similarity when not equal
