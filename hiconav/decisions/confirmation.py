@@ -16,7 +16,7 @@ goal, ticks a tree or talks to an actor.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any, Iterable, Sequence
+from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -69,10 +69,11 @@ def detected_too_near(anchor: Any, box_min: np.ndarray, box_max: np.ndarray, lab
     return box_distance(box_min, box_max, cam) <= near
 
 
-def frames_since(anchors: Sequence[Any], last: int | None) -> tuple[list[Any], int | None]:
+def frames_since(anchors: Sequence[Any], last: int | None,
+                 earlier: Callable[[Any], bool] | None = None) -> tuple[list[Any], int | None]:
     """The anchors newer than ``last`` (the newest anchor already judged), oldest first, and the
-    new ``last``. With ``last`` None (the robot just came close) none: frames from before the
-    robot came close do not count, and the newest anchor becomes ``last``.
+    new ``last``. With ``last`` None (the robot just came close) only those ``earlier`` accepts
+    (none without it), and the newest anchor becomes ``last``.
 
     Anchors, not the memory's version, are the frames: the version also moves when anchor
     pruning removes keyframes, and those "frames" show nothing."""
@@ -80,7 +81,8 @@ def frames_since(anchors: Sequence[Any], last: int | None) -> tuple[list[Any], i
         return [], last
     newest = max(int(a.id) for a in anchors)
     if last is None:
-        return [], newest
+        kept = [] if earlier is None else [a for a in anchors if earlier(a)]
+        return sorted(kept, key=lambda a: int(a.id)), newest
     fresh = [a for a in anchors if int(a.id) > last]
     if not fresh:
         return [], last
@@ -102,6 +104,18 @@ class Tally:
     target_reads: int = 0
     unseen: int = 0
     fresh_by: tuple[tuple[int, int], ...] = ()
+
+
+def recent_close(anchor: Any, *, since: float, box_min: np.ndarray, box_max: np.ndarray, close: float) -> bool:
+    """Whether ``anchor`` is a frame a verification that began at clock ``since`` plus its
+    ``recent_view_s`` may count: taken since ``since``, its camera within ``close`` m (the view
+    ring) of the candidate's box (3,) world.
+
+    A robot that drove up to a candidate saw it from where a view cell would stand before the
+    verification began (a search that comes upon it on its way); judging only the frames after
+    that start sends it off to a view cell for views it already has, and back."""
+    cam = np.asarray(anchor.T_world_cam, dtype=np.float64)[:2, 3]
+    return float(anchor.stamp) >= since and box_distance(box_min, box_max, cam) <= close
 
 
 def read_labels(anchor: Any, observed: set[int]) -> set[str]:
@@ -271,5 +285,5 @@ def restart_unseen(tally: Tally) -> Tally:
 
 
 __all__ = ["Tally", "Verdict", "confirmed_node", "deferred", "detected_too_near", "evidence_verdict", "for_good",
-           "frames_since", "judge_frames", "label_verdict", "read_labels", "restart_unseen", "same_object", "support_confidence",
+           "frames_since", "judge_frames", "label_verdict", "read_labels", "recent_close", "restart_unseen", "same_object", "support_confidence",
            "support_ids", "support_observations", "target_labels", "timeout_verdict"]

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import partial
 from typing import Any, Callable, Iterable, TypeVar
 
 import numpy as np
@@ -26,6 +27,7 @@ import numpy as np
 from hiconav.decisions.cells import camera_of, furniture_boxes, wall_heights
 from hiconav.decisions.config import VerifySettings
 from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, evidence_verdict, for_good, frames_since,
+                                            recent_close,
                                             deferred, judge_frames, restart_unseen, same_object, support_ids,
                                             target_labels, timeout_verdict)
 from hiconav.decisions.geometry import facing
@@ -35,6 +37,8 @@ from hiconav.types import Goal, wrap_angle
 
 #: goal tolerances (m): a closer cell, a view cell through unknown floor, a glance in place
 CLOSER_TOLERANCE, UNKNOWN_TOLERANCE, GLANCE_TOLERANCE = 0.3, 0.2, 0.5
+#: the source of a candidate the reasoning layer put forward (``Candidate.source``)
+HYPOTHESIS = "hypothesis"
 
 C = TypeVar("C")
 
@@ -126,12 +130,24 @@ class Verification:
         observed more often (``confirmation.confirmed_node``); for a ``described`` instance only
         when that node is the same object seen again (``confirmation.same_object``): the
         reasoning layer chose the candidate by its relations, and a neighbour of the same label
-        whose box touches it (chairs around a table) is another instance, not checked."""
+        whose box touches it (chairs around a table) is another instance, not checked.
+
+        The frames of a candidate the reasoning layer put forward (source "hypothesis") taken
+        within ``recent_view_s`` before the verification began from within the view ring count
+        as well (``confirmation.recent_close``): the reasoning layer verified it on its images
+        once already, and a robot that came upon it on its way has the views a view cell would
+        give. A candidate taken for its label alone ("memory-label") is judged on frames after
+        the start only: the frame that made a spurious box would count as its first view. Frames
+        from the wider close distance are not taken: from there a look-alike is read as the
+        target about as often as not."""
         self.close = gap <= close_distance(settings, ring)
         if not self.close:
             return None
         anchors, objects = tuple(getattr(memory, "anchors", ()) or ()), memory.objects
-        frames, self.last_anchor = frames_since(anchors, self.last_anchor)
+        earlier = None if settings.recent_view_s <= 0.0 or getattr(cand, "source", None) != HYPOTHESIS else partial(
+            recent_close, since=self.start - settings.recent_view_s, box_min=cand.box_min, box_max=cand.box_max,
+            close=ring)
+        frames, self.last_anchor = frames_since(anchors, self.last_anchor, earlier)
         targets, support, hiding = evidence_inputs(settings, memory, task_targets, cand)
         if frames:
             self.tally = judge_frames(self.tally, frames, objects=objects, grid=grid, center=cand.center,

@@ -39,6 +39,7 @@ class Anchor:
     labels_seen: tuple = ()
     intrinsics: CameraIntrinsics = CameraIntrinsics.from_hfov(640, 480, 79.0)
     object_labels: tuple = ()  # row j: the labels placed on object_ids[j] (empty: not recorded)
+    stamp: float = 0.0  # clock s the frame was taken
 
 
 @dataclass

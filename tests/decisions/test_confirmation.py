@@ -3,6 +3,7 @@ anchors: which nodes support a candidate, which frames count, and the verdicts t
 
 from __future__ import annotations
 
+from functools import partial
 
 import numpy as np
 
@@ -53,6 +54,20 @@ def test_frames_from_before_the_robot_came_close_do_not_count():
     later = anchors + (facing_bed(7), facing_bed(6))
     frames, last = conf.frames_since(later, 5)
     assert [a.id for a in frames] == [6, 7] and last == 7
+
+
+def test_recent_frames_from_near_the_candidate_count_when_the_robot_comes_close():
+    def at(aid: int, x: float, stamp: float) -> Anchor:
+        return Anchor(aid, camera_pose_from_base(Pose2D(x, 5.0, 0.0), 0.4), stamp=stamp)
+
+    anchors = (at(1, 3.5, 1.0), at(2, 0.5, 4.0), at(3, 3.0, 5.0), at(4, 3.8, 6.0))
+    keep = partial(conf.recent_close, since=3.0, box_min=LO, box_max=HI, close=2.0)
+    frames, last = conf.frames_since(anchors, None, keep)
+    # 1 is too old, 2 stood 4 m from the box; 3 (1.5 m) and 4 (0.7 m) count, oldest first
+    assert [a.id for a in frames] == [3, 4] and last == 4
+    assert conf.frames_since(anchors, 4, keep) == ([], 4)  # only when the robot first comes close
+    assert conf.frames_since(anchors, None) == ([], 4)
+    assert not conf.recent_close(at(5, 3.5, 2.9), since=3.0, box_min=LO, box_max=HI, close=2.0)
 
 
 def test_a_frame_that_observed_a_supporting_node_is_a_fresh_view():

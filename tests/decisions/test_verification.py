@@ -44,6 +44,7 @@ class Cand:
     box_min: np.ndarray
     box_max: np.ndarray
     n_obs: int = 1
+    source: str = "memory-label"
 
 
 @dataclass(frozen=True)
@@ -82,6 +83,32 @@ def test_frames_are_judged_only_within_the_close_distance_and_only_those_made_af
     assert judge(v, memory, gap=close_distance(S, RING) + 0.1) is None and not v.close and v.last_anchor is None
     assert judge(v, memory) is None and v.close and v.last_anchor == 10 and v.tally.in_view == 0
     assert v.judging
+
+
+def test_frames_taken_close_just_before_the_verification_of_a_hypothesis_began_count_with_recent_view_s():
+    """A robot that drove up to a candidate the reasoning layer put forward saw it from as near as a
+    view cell would stand: those frames confirm it at once, where without them it drove off to a
+    view cell for two more. A candidate taken for its label alone gets no such frames: the frame
+    that made a spurious box would be its first view."""
+    def seen(aid: int, stamp: float, x: float = 3.5) -> Anchor:
+        return Anchor(aid, camera_pose_from_base(Pose2D(x, 5.0, 0.0), 0.4), (1,), ("bed",), stamp=stamp)
+
+    memory = Memory([node(1, "bed", 5, 5)], [seen(9, 2.0), seen(10, 8.5), seen(11, 9.5)])
+    recent = S.model_copy(update={"recent_view_s": 2.0})
+    hypothesis = Cand(1, "bed", CENTRE, LO, HI, source=verif.HYPOTHESIS)
+    v = verif.Verification(10.0)
+    judged = v.judge(recent, 1.0, RING, memory, None, hypothesis, ["bed"], "bed")
+    assert judged is not None and judged.confirmed and v.tally.in_view == 2  # anchor 9 is too old
+    v = verif.Verification(10.0)
+    assert v.judge(recent, 1.0, RING, memory, None, BED, ["bed"], "bed") is None and v.tally.in_view == 0
+    v = verif.Verification(10.0)
+    none = S.model_copy(update={"recent_view_s": 0.0})
+    assert v.judge(none, 1.0, RING, memory, None, hypothesis, ["bed"], "bed") is None  # only frames after the start
+    # beyond the view ring (1.3 m from the box), though within the close distance: not a view cell's frame
+    assert RING < 1.3 < close_distance(S, RING)
+    far = Memory([node(1, "bed", 5, 5)], [seen(10, 8.5, x=3.2), seen(11, 9.5, x=3.2)])
+    v = verif.Verification(10.0)
+    assert v.judge(recent, 1.0, RING, far, None, hypothesis, ["bed"], "bed") is None and v.tally.in_view == 0
 
 
 def test_fresh_views_of_the_candidate_confirm_it_and_name_no_other_node():
