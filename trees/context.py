@@ -22,6 +22,7 @@ import numpy as np
 
 from hiconav.decisions import last_resort as resort
 from hiconav.decisions.config import DecisionsConfig
+from hiconav.decisions.verification import HYPOTHESIS
 from hiconav.geometry import footprint_distance
 from hiconav.messages import ExploredOut, GoalMsg, KeyframeRequest, NavStatus, ParseRequest, StopRequest
 from hiconav.reasoning.grounding import target_relations
@@ -290,7 +291,7 @@ class MissionContext:
             if oid is None or oid in seen or self.excluded(oid):
                 continue
             seen.add(oid)
-            out.append(self.candidate_of(objects[oid], "hypothesis", float(getattr(hyp, "confidence", 0.0))))
+            out.append(self.candidate_of(objects[oid], HYPOTHESIS, float(getattr(hyp, "confidence", 0.0))))
         if self.use_memory_labels and not (self.reasoning and self.described):
             targets = set(self.task.targets)
             matches = [o for o in memory.objects if o.label in targets and not self.excluded(o.id)

@@ -26,10 +26,9 @@ import numpy as np
 
 from hiconav.decisions.cells import camera_of, furniture_boxes, wall_heights
 from hiconav.decisions.config import VerifySettings
-from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, evidence_verdict, for_good, frames_since,
-                                            recent_close,
-                                            deferred, judge_frames, restart_unseen, same_object, support_ids,
-                                            target_labels, timeout_verdict)
+from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, deferred, evidence_verdict, for_good,
+                                            frames_since, judge_frames, recent_close, restart_unseen, same_object,
+                                            support_ids, target_labels, timeout_verdict)
 from hiconav.decisions.geometry import facing
 from hiconav.decisions.viewing import (ViewMove, blockers, close_distance, fallback_cell, nearer_candidate, next_view_move,
                                       sight, stall_matters, views_from_here)
@@ -306,6 +305,6 @@ def posting(settings: VerifySettings, verdict: Verdict, object_id: int, rejectio
     return Posting(for_good(settings, verdict.permanent, remap, count), verdict.requalify, remap)
 
 
-__all__ = ["CLOSER_TOLERANCE", "CellGoal", "GLANCE_TOLERANCE", "Judgement", "Posting", "Switch", "UNKNOWN_TOLERANCE",
+__all__ = ["CLOSER_TOLERANCE", "CellGoal", "GLANCE_TOLERANCE", "HYPOTHESIS", "Judgement", "Posting", "Switch", "UNKNOWN_TOLERANCE",
            "Verification", "evidence_inputs", "hiding", "move_verdict", "nearer_switch", "node_fields",
            "posting", "sight_of", "view_feedback", "view_here"]
