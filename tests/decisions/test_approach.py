@@ -195,7 +195,7 @@ def test_with_path_cost_the_cell_on_the_robots_side_of_furniture_wins_over_the_n
 
     def walk(c):
         return float(lengths[int(c[1] / res), int(c[0] / res)])
-    assert walk(path) < walk(line) - 1.0  # the line's pick is a walk round the bed
+    assert walk(path) < walk(line) - 1.0  # the line's pick is a walk round the table
     assert rounded_box_distance(path[0], path[1], LO, HI, 0.0) <= 1.2 + 1e-9
 
 
