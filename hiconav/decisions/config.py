@@ -155,8 +155,8 @@ class VerifySettings(_Section):
 class ApproachSettings(_Section):
     """Approach: the final ring, the straight-in step and the creep (``hiconav.decisions.approach``)."""
 
-    distance: float = _f(0.85, "stop this near the target's box: 0.15 m inside the 1 m success distance for the "
-                               "box's error", 0.1, 5.0)
+    distance: float = _f(0.9, "stop this near the target's box: 0.1 m inside the 1 m success distance for the "
+                              "box's error", 0.1, 5.0)
     inner_margin: float = _f(0.0, "the first ring tried lies this far inside the distance (m)", 0.0, 5.0)
     settle_rings: list[float] = _f([1.0, 1.25, 1.5, 2.0], "wider rings to settle on, up to max_distance, when "
                                                            "furniture leaves no free cell within the distance")
