@@ -78,11 +78,6 @@ class ExploreSettings(_Section):
                            0, 100)
     linger_m: float = _f(1.5, "an instance within this of the robot's footprint distance is close enough to "
                               "linger by (m)", 0.0, 10.0)
-    linger_step_back: bool = _f(True, "after those turns, beside an instance the instruction places below something "
-                                      "(\"the bed below the painting\"), step back to where the camera sees above it "
-                                      "(hiconav.decisions.linger.step_back_goal)")
-    step_back_spare_deg: float = _f(8.0, "the step back holds a point 1.8 m up this far inside the camera's vertical "
-                                         "field of view (degrees)", 0.0, 45.0)
     last_resort: bool = _f(True, "explored out with a candidate set aside only as out of reach (no view point or "
                                  "approach cell it could reach): stop as near the best of it as the map allows "
                                  "rather than fail (hiconav.decisions.last_resort)")

@@ -1621,33 +1621,3 @@ def test_explore_turns_beside_an_undecided_described_instance_once_then_explores
             ctx.nav = NavStatus(goal.seq, "reached", 0.0)
         assert (kinds[:2] == ["look", "look"] and kinds[2] != "look") is lingers, kinds
         assert (3 in ctx.lingered) is lingers
-
-
-def test_explore_steps_back_from_an_instance_described_below_something_after_its_turns(tmp_path):
-    """"The bed below the painting": after the turns beside an undecided bed the robot steps back
-    to a cell about 2 m from it, facing it, where the camera sees above the bed, then explores
-    on; "the bed next to the dresser" and ``linger_step_back: false`` go straight back to the plan."""
-    below = TaskSpec("the bed below the painting", ("bed",), ("painting",), relations=(("bed", "below", "painting"),))
-    beside = TaskSpec("the bed next to the dresser", ("bed",), ("dresser",), relations=(("bed", "next to", "dresser"),))
-    for task, params, steps in ((below, "{linger_turns: 2}", True), (beside, "{linger_turns: 2}", False),
-                                (below, "{linger_turns: 2, linger_step_back: false}", False)):
-        clock = Clock()
-        ctx = _ctx(clock)
-        ctx.task = task
-        ctx.world = world(Pose2D(5.0, 6.2, 0.0), [obj(3, "bed", 5.0, 5.0)],
-                          anchors=[anchor(1, Pose2D(5.0, 6.2, 0.0), height=0.88)])
-        ctx.plan = plan((8.0, 8.0))
-        tree = MissionTree(_write(tmp_path, f"root:\n  Explore: {params}\n"), ctx)
-        goals = []
-        for _ in range(4):
-            clock.t += 0.5
-            tree.tick()
-            goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
-            goals.append(goal.goal)
-            ctx.nav = NavStatus(goal.seq, "reached", 0.0)
-        assert [g.kind for g in goals[:2]] == ["look", "look"]
-        back = goals[2]
-        assert (back.kind == "approach") is steps, goals
-        if steps:
-            assert back.y > 7.0 and abs(back.yaw - math.atan2(5.0 - back.y, 5.0 - back.x)) < 1e-6
-            assert goals[3].kind == "frontier"

@@ -9,7 +9,6 @@ pose, the state of the goal in flight, the mission's record of exploration), ask
 from __future__ import annotations
 
 from hiconav.decisions import linger
-from hiconav.decisions.cells import camera_of
 from hiconav.decisions.frontiers import ExploreLedger, FrontierFollower, FrontierGoal, PlanView, look_goal
 from hiconav.trees.behaviours.base import MissionBehaviour, Status
 from hiconav.trees.registry import register_behaviour
@@ -72,9 +71,8 @@ class Explore(MissionBehaviour):
 
     def _linger(self) -> bool:
         """Turn in place beside an undecided instance of a described target's category come upon
-        close by (``linger.undecided_near``), ``linger_turns`` quarter turns once per instance (and a
-        step back from one described below something, ``_step_back``), then explore on afresh:
-        True while turning or stepping back."""
+        close by (``linger.undecided_near``), ``linger_turns`` quarter turns once per instance, then
+        explore on afresh: True while turning."""
         ctx, s, pose = self.context, self.settings, self.context.pose
         if self._lingering is not None:
             if ctx.nav_state(self._seq) not in ("reached", "failed"):
@@ -82,8 +80,6 @@ class Explore(MissionBehaviour):
             self._turns += 1
             if self._turns < s.linger_turns:
                 self._seq = ctx.send_goal(_goal(look_goal(pose)))
-                return True
-            if self._turns == s.linger_turns and self._step_back(self._lingering):
                 return True
             self._lingering, self._seq, self._follower = None, None, FrontierFollower()
             return False
@@ -99,21 +95,6 @@ class Explore(MissionBehaviour):
         self._lingering, self._turns, ctx.last_frontier_time = oid, 0, ctx.now()
         self._seq = ctx.send_goal(_goal(look_goal(pose)))
         self.feedback_message = f"looking around #{oid}"
-        return True
-
-    def _step_back(self, oid: int) -> bool:
-        """After the turns beside an instance described as below something, step back to where the
-        camera sees above it (``linger.step_back_goal``): True when a goal was sent."""
-        ctx, pose, obj = self.context, self.context.pose, self.context.object(oid)
-        if not self.settings.linger_step_back or oid in ctx.ruled_out or pose is None or obj is None or ctx.grid is None:
-            return False
-        goal = linger.step_back_goal(ctx.task.relations, ctx.task.targets, obj.box_min, obj.box_max,
-                                     (pose.x, pose.y), ctx.grid, camera_of(ctx.memory), self.settings.step_back_spare_deg)
-        if goal is None:
-            return False
-        self._seq = ctx.send_goal(Goal(*goal, 0.3, "approach", oid))
-        ctx.log(f"Explore: stepping back from #{oid} to see above it")
-        self.feedback_message = f"stepping back from #{oid}"
         return True
 
     def _asks_left(self) -> int:
