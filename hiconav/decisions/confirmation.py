@@ -65,8 +65,12 @@ def detected_too_near(anchor: Any, box_min: np.ndarray, box_max: np.ndarray, lab
     the detector saw: a detection placed elsewhere explains its label instead."""
     if near <= 0.0 or any(labels.get(int(i)) in targets for i in anchor.object_ids):
         return False
-    cam = np.asarray(anchor.T_world_cam, dtype=np.float64)[:2, 3]
-    return box_distance(box_min, box_max, cam) <= near
+    return camera_gap(anchor, box_min, box_max) <= near
+
+
+def camera_gap(anchor: Any, box_min: np.ndarray, box_max: np.ndarray) -> float:
+    """How far (m, in plan) ``anchor``'s camera stood from the candidate's box (3,) world."""
+    return box_distance(box_min, box_max, np.asarray(anchor.T_world_cam, dtype=np.float64)[:2, 3])
 
 
 def frames_since(anchors: Sequence[Any], last: int | None,
@@ -114,8 +118,7 @@ def recent_close(anchor: Any, *, since: float, box_min: np.ndarray, box_max: np.
     A robot that drove up to a candidate saw it from where a view cell would stand before the
     verification began (a search that comes upon it on its way); judging only the frames after
     that start sends it off to a view cell for views it already has, and back."""
-    cam = np.asarray(anchor.T_world_cam, dtype=np.float64)[:2, 3]
-    return float(anchor.stamp) >= since and box_distance(box_min, box_max, cam) <= close
+    return float(anchor.stamp) >= since and camera_gap(anchor, box_min, box_max) <= close
 
 
 def read_labels(anchor: Any, observed: set[int]) -> set[str]:
@@ -284,6 +287,6 @@ def restart_unseen(tally: Tally) -> Tally:
     return replace(tally, unseen=0)
 
 
-__all__ = ["Tally", "Verdict", "confirmed_node", "deferred", "detected_too_near", "evidence_verdict", "for_good",
+__all__ = ["Tally", "Verdict", "camera_gap", "confirmed_node", "deferred", "detected_too_near", "evidence_verdict", "for_good",
            "frames_since", "judge_frames", "label_verdict", "read_labels", "recent_close", "restart_unseen", "same_object", "support_confidence",
            "support_ids", "support_observations", "target_labels", "timeout_verdict"]
