@@ -32,6 +32,7 @@ SUBCOMMANDS: list[tuple[str, str, str]] = [
     ("vehicle", "hiconav.drivers.cli", "vehicle"),
     ("parse", "hiconav.reasoning.cli", "parse"),
     ("room-prior", "hiconav.reasoning.cli", "room_prior"),
+    ("size-prior", "hiconav.reasoning.cli", "size_prior"),
     ("eval", "hiconav.eval.cli", "eval"),
     ("episodes", "hiconav.sim.episodes_cli", "episodes"),
     ("tree", "hiconav.trees.cli", "tree"),

@@ -90,3 +90,27 @@ def room_prior(
     rp.save(prior, target)
     n = sum(sum(c.values()) for c in prior.counts.values())
     typer.echo(json.dumps({"houses": houses, "categories": len(prior.counts), "objects": n, "out": target}))
+
+
+def size_prior(
+    houses: str = typer.Option(..., "--houses", help="A ProcTHOR houses file (.jsonl or .jsonl.gz), anywhere on "
+                               "disk: training houses only, never those you report on."),
+    out: str = typer.Option(None, "--out", help="Where to write the sizes (default: the shipped "
+                            "hiconav/reasoning/size_prior.json)."),
+    min_count: int = typer.Option(5, "--min-count", min=1, help="Categories with fewer instances get no size."),
+) -> None:
+    """Median footprint sides of each object category in houses: the size prior the offline
+    reasoner tells a box seen in part by (``reasoning.offline.size_prior`` points it at a file of
+    your own)."""
+    from pathlib import Path
+
+    from hiconav.reasoning import room_prior as rp
+    from hiconav.reasoning import size_prior as sp
+
+    target = out or str(sp.DEFAULT_FILE)
+    prior = sp.learn(rp.houses_of(houses), source=Path(houses).name, min_count=min_count)
+    if not prior.sizes:
+        raise typer.BadParameter(f"{houses}: no category has {min_count} instances or more", param_hint="--houses")
+    sp.save(prior, target)
+    typer.echo(json.dumps({"houses": houses, "categories": len(prior.sizes),
+                           "objects": sum(prior.counts.values()), "out": target}))

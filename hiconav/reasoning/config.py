@@ -77,6 +77,10 @@ class OfflineVerifierConfig(BaseModel):
     # ``hiconav room-prior --houses FILE``); None: the shipped counts, from
     # the ProcTHOR train houses
     room_prior: str | None = None
+    # the median footprint sides per category that tell a related object's box seen in part (a
+    # file written by ``hiconav size-prior --houses FILE``); None: the shipped sizes, from the
+    # ProcTHOR train houses
+    size_prior: str | None = None
 
 
 class ReasoningConfig(BaseModel):

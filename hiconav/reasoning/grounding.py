@@ -22,9 +22,11 @@ for a subgraph (the VLM path answers the same question from the subgraph's image
 
 Verdicts are "holds", "marginal" (every relation holds, some only within the memory boxes'
 noise margin: ``relation_grade``), "fails" or "unknown" (the related object is not in the
-subgraph, or no room can be inferred), so a described instance is confirmed only when every
+subgraph, its box is narrower than an object of its kind is across so that the whole object may
+stand within reach, ``size_prior``, or no room can be inferred), so a described instance is confirmed only when every
 relation holds; a marginal one is offered after a wait (``unresolved.due_marginal``). Pure
-functions; no clocks, and no I/O but the first read of the shipped room prior (package data).
+functions; no clocks, and no I/O but the first read of the shipped room and size priors
+(package data).
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ from hiconav.geometry import centre_in_footprint, footprint_gap
 from hiconav.reasoning.decompose import CONTAINMENT
 from hiconav.reasoning.decompose import ROOMS as PARSER_ROOMS
 from hiconav.reasoning.room_prior import ROOMS, default_log_ratios
+from hiconav.reasoning.size_prior import default_sizes
 from hiconav.relations import NEAR, NEXT_TO
 from hiconav.types import label_key
 
@@ -69,6 +72,9 @@ HUNG_THIN_M = 0.2
 # thing hung on that wall: built from the depth points of its front and top, the box of a bed,
 # dresser or chair pushed against the wall rarely reaches the wall behind it
 HUNG_REACH_M = 0.8
+# m: a memory box narrower than its category's short side (``size_prior``) by more than this along
+# an axis is seen in part: a relation that fails on it may hold on the whole object
+SHORT_OF_SIZE_M = 0.2
 ROOM_DECAY_M = 2.5  # m: a room cue's weight falls by e over this planar distance
 ROOM_REACH_M = 6.0  # m: cues farther than this say nothing of an object's room
 # below this posterior the room is unknown (chosen on ProcTHOR train textnav, seeds 0 and 1)
@@ -135,6 +141,52 @@ def hung_over(top: BoxLike, low: BoxLike) -> bool:
         if along and across <= HUNG_REACH_M:
             return True
     return False
+
+
+@dataclass(frozen=True)
+class _Box:
+    id: int
+    label: str
+    box_min: np.ndarray
+    box_max: np.ndarray
+
+
+def grown_toward(box: BoxLike, toward: BoxLike, size: tuple[float, float] | None) -> _Box | None:
+    """The box ``box`` may still grow to, toward ``toward``: where its footprint is narrower than
+    its category's short side (``size``: long, short side, metres) by more than
+    ``SHORT_OF_SIZE_M`` along an axis (narrower than any common object of its kind is across:
+    seen edge-on or in part, for sure), that axis extended to the short side on the side facing
+    ``toward``'s centre. None when the box is not short of its size or the category has none."""
+    if size is None:
+        return None
+    b0, b1 = np.asarray(box.box_min, float), np.asarray(box.box_max, float)
+    short = float(size[1]) - (b1[:2] - b0[:2])
+    grow = np.where(short > SHORT_OF_SIZE_M, short, 0.0)
+    if not np.any(grow > 0.0):
+        return None
+    here = (b0[:2] + b1[:2]) / 2.0
+    there = (np.asarray(toward.box_min, float)[:2] + np.asarray(toward.box_max, float)[:2]) / 2.0
+    lo, hi = b0.copy(), b1.copy()
+    for k in (0, 1):
+        if there[k] >= here[k]:
+            hi[k] += grow[k]
+        else:
+            lo[k] -= grow[k]
+    return _Box(int(box.id), str(box.label), lo, hi)
+
+
+def could_hold(relation: str, a: BoxLike, b: BoxLike, sizes: Mapping[str, tuple[float, float]]) -> bool:
+    """Whether ``relation`` of ``a`` to the related object ``b``, failing on their boxes, would
+    hold (or hold within the noise margin) once ``b``'s box, seen in part, grew toward ``a`` to
+    its category's short side (``grown_toward``; ``sizes``: category -> (long, short) m). Only the
+    related object grows: a candidate's own box seen in part is what the verification views are
+    for, and growing it too kept wrong instances of the category open on train. Rooms ("in")
+    never grow."""
+    rel = relation.strip().lower()
+    if rel == "in":
+        return False
+    grown = grown_toward(b, a, sizes.get(label_key(str(b.label))))
+    return grown is not None and relation_grade(rel, a, grown) != "fails"
 
 
 def _centre_in_plan(a: BoxLike, b: BoxLike, pad: float = 0.10) -> bool:
@@ -254,21 +306,26 @@ def target_relations(relations: Iterable[Sequence[str]], targets: Iterable[str])
 
 
 def ground(candidate: BoxLike, objects: Sequence[BoxLike], relations: Sequence[Sequence[str]],
-           targets: Sequence[str], rooms: dict[int, tuple[str | None, float]] | None = None) -> Grounding:
+           targets: Sequence[str], rooms: dict[int, tuple[str | None, float]] | None = None,
+           sizes: Mapping[str, tuple[float, float]] | None = None) -> Grounding:
     """Check every relation of ``relations`` whose subject is a target on ``candidate``.
 
     ``objects``: the nodes to ground on (the subgraph's; ``candidate`` among them); relations of a
     related object ("the floor lamp in the living room") are checked one level down, on the node
-    that satisfied the target's relation. Holds only when every relation holds.
+    that satisfied the target's relation. Holds only when every relation holds. ``sizes``:
+    category -> (long, short) footprint sides in metres (default: the shipped ``size_prior``); a
+    relation that fails only because a related object's box is narrower than its kind is across
+    is "unknown" (``could_hold``).
     """
     rooms = rooms if rooms is not None else infer_rooms(objects, ignore=targets)
+    sizes = default_sizes() if sizes is None else sizes
     rels = target_relations(relations, targets)
     if not rels:
         return Grounding(candidate.id, "holds", ("no relation to check",))
     evidence: list[str] = []
     statuses: list[str] = []
     for subject, rel, obj in rels:
-        status, line = _one(candidate, rel, obj, objects, relations, rooms, depth=0)
+        status, line = _one(candidate, rel, obj, objects, relations, rooms, depth=0, sizes=sizes)
         statuses.append(status)
         evidence.append(f"{subject} {rel} {obj}: {status} ({line})")
     status = next(s for s in ("fails", "unknown", "marginal", "holds") if s in statuses)
@@ -276,7 +333,8 @@ def ground(candidate: BoxLike, objects: Sequence[BoxLike], relations: Sequence[S
 
 
 def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relations: Sequence[Sequence[str]],
-         rooms: dict[int, tuple[str | None, float]], depth: int) -> tuple[str, str]:
+         rooms: dict[int, tuple[str | None, float]], depth: int,
+         sizes: Mapping[str, tuple[float, float]] | None = None) -> tuple[str, str]:
     room = room_of(obj)
     if room is None and label_key(obj) in UNINFERRED_ROOMS:
         # "the table in the dining room": a room type the room prior does not tell apart; waiting
@@ -296,12 +354,15 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
               if labels_match(s2, obj) and not labels_match(o2, node.label)] if depth == 0 else []
     best = "fails"
     line = ""
+    partial: BoxLike | None = None  # the nearest related object the relation would hold on, grown
     for other in sorted(others, key=lambda o: planar_gap(node, o)):
         grade = relation_grade(rel, node, other)
         if grade == "fails":
+            if partial is None and sizes and could_hold(rel, node, other, sizes):
+                partial = other
             continue
         if nested:
-            sub = [_one(other, r, o2, objects, relations, rooms, depth=1)[0] for r, o2 in nested]
+            sub = [_one(other, r, o2, objects, relations, rooms, depth=1, sizes=sizes)[0] for r, o2 in nested]
             if "fails" in sub:
                 line = f"#{other.id} is {rel} it, but not {', '.join(f'{r} {o2}' for r, o2 in nested)}"
                 continue
@@ -315,6 +376,12 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
             return "holds", f"#{other.id} at {planar_gap(node, other):.2f} m"
         if best != "marginal":
             best, line = "marginal", f"#{other.id} at {planar_gap(node, other):.2f} m, within the boxes' noise margin only"
+    if best == "fails" and partial is not None and not line:
+        # a related object seen in part (a counter seen edge-on, the near end of a table): the
+        # relation fails on its box but would hold on the whole object; what the robot has seen
+        # does not rule the candidate out
+        return "unknown", (f"#{partial.id} at {planar_gap(node, partial):.2f} m, its box narrower "
+                           f"than a {obj.replace('_', ' ')} is across: seen in part")
     if not line:
         line = f"nearest {obj} #{min(others, key=lambda o: planar_gap(node, o)).id} at " \
                f"{min(planar_gap(node, o) for o in others):.2f} m"

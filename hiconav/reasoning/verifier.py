@@ -25,6 +25,8 @@ import numpy as np
 from hiconav.reasoning.grounding import ground, infer_rooms, target_relations
 from hiconav.reasoning.room_prior import load as load_room_prior
 from hiconav.reasoning.room_prior import log_ratios
+from hiconav.reasoning.size_prior import default_sizes
+from hiconav.reasoning.size_prior import load as load_size_prior
 
 from hiconav.reasoning import replies
 from hiconav.reasoning.config import ReasoningConfig
@@ -221,6 +223,11 @@ class OfflineVerifier:
             self._room_cues = log_ratios(load_room_prior(path)) if path else None
         except (OSError, ValueError) as exc:
             raise ValueError(f"reasoning.offline.room_prior: {exc}") from None
+        path = self.config.offline.size_prior
+        try:
+            self._sizes = dict(load_size_prior(path).sizes) if path else default_sizes()
+        except (OSError, ValueError) as exc:
+            raise ValueError(f"reasoning.offline.size_prior: {exc}") from None
 
     def cancel(self) -> None:  # same interface as VLMVerifier; nothing in flight
         return None
@@ -286,7 +293,7 @@ class OfflineVerifier:
                 continue
             if described:
                 # relations on the map: the subgraph's objects and the nodes mapped near it
-                verdict = ground(obj, support, task.relations, task.targets, rooms)
+                verdict = ground(obj, support, task.relations, task.targets, rooms, self._sizes)
                 groundings[obj.id] = verdict
                 if verdict.status != "holds":
                     reasons.append(RELATION_FAILED if verdict.status == "fails" else RELATION_UNKNOWN)
