@@ -22,11 +22,11 @@ for a subgraph (the VLM path answers the same question from the subgraph's image
 
 Verdicts are "holds", "marginal" (every relation holds, some only within the memory boxes'
 noise margin: ``relation_grade``), "fails" or "unknown" (the related object is not in the
-subgraph, its box is narrower than an object of its kind is across so that the whole object may
-stand within reach, ``size_prior``, or no room can be inferred), so a described instance is confirmed only when every
-relation holds; a marginal one is offered after a wait (``unresolved.due_marginal``). Pure
-functions; no clocks, and no I/O but the first read of the shipped room and size priors
-(package data).
+subgraph, or its box is narrower than an object of its kind is across and the whole object may
+stand within reach: ``could_hold``, ``size_prior``; or no room can be inferred), so a described
+instance is confirmed only when every relation holds; a marginal one is offered after a wait
+(``unresolved.due_marginal``). Pure functions; no clocks, and no I/O but the first read of
+the shipped room and size priors (package data).
 """
 
 from __future__ import annotations
