@@ -128,13 +128,17 @@ def from_json(data: Any, path: str = "") -> RoomPrior:
     return RoomPrior(counts, str(data.get("source", "")))
 
 
-def load(path: str | Path = DEFAULT_FILE) -> RoomPrior:
+def read_json(path: str | Path) -> Any:
+    """The JSON of a prior file; a ``ValueError`` naming the file and line where it is not JSON."""
     p = Path(path)
     try:
-        data = json.loads(p.read_text())
+        return json.loads(p.read_text())
     except json.JSONDecodeError as e:
         raise ValueError(f"{p}: line {e.lineno}: not JSON ({e.msg})") from None
-    return from_json(data, str(p))
+
+
+def load(path: str | Path = DEFAULT_FILE) -> RoomPrior:
+    return from_json(read_json(path), str(Path(path)))
 
 
 @lru_cache(maxsize=1)

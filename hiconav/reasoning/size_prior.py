@@ -29,6 +29,8 @@ from typing import Any
 
 import numpy as np
 
+from hiconav.reasoning.room_prior import read_json
+
 __all__ = ["DEFAULT_FILE", "MIN_COUNT", "SizePrior", "default_sizes", "learn", "load", "save"]
 
 #: a category with fewer instances than this in the training houses has no size
@@ -104,12 +106,7 @@ def from_json(data: Any, path: str = "") -> SizePrior:
 
 
 def load(path: str | Path = DEFAULT_FILE) -> SizePrior:
-    p = Path(path)
-    try:
-        data = json.loads(p.read_text())
-    except json.JSONDecodeError as e:
-        raise ValueError(f"{p}: line {e.lineno}: not JSON ({e.msg})") from None
-    return from_json(data, str(p))
+    return from_json(read_json(path), str(Path(path)))
 
 
 @lru_cache(maxsize=1)

@@ -85,3 +85,17 @@ def fast_vlm(base_url: str, **over) -> VLMConfig:
 
 def fast_config(base_url: str, **over) -> ReasoningConfig:
     return ReasoningConfig(vlm=fast_vlm(base_url, **over))
+
+
+def houses_elsewhere(source, tmp_path, n: int, name: str):
+    """The first ``n`` houses of the ProcTHOR file ``source``, written to ``tmp_path/elsewhere/name``
+    (a .jsonl.gz outside the data root); its path."""
+    import gzip
+
+    with gzip.open(source, "rt", encoding="utf-8") as fh:
+        lines = [next(fh) for _ in range(n)]
+    houses = tmp_path / "elsewhere" / name
+    houses.parent.mkdir(exist_ok=True)
+    with gzip.open(houses, "wt", encoding="utf-8") as fh:
+        fh.writelines(lines)
+    return houses

@@ -3,7 +3,6 @@ likelihood ratios, the shipped file and its command line."""
 
 from __future__ import annotations
 
-import gzip
 import json
 import math
 from pathlib import Path
@@ -15,6 +14,7 @@ from hiconav.reasoning import room_prior
 from hiconav.reasoning.grounding import infer_rooms
 from hiconav.reasoning.room_prior import RoomPrior, from_json, load, log_ratios
 
+from .helpers import houses_elsewhere
 from .test_grounding import node
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "procthor" / "train.jsonl.gz"
@@ -70,12 +70,7 @@ def test_a_broken_prior_file_is_named_with_its_field(tmp_path):
 
 @pytest.mark.skipif(not SHARED.is_file(), reason="needs ../shared/data/procthor/train.jsonl.gz")
 def test_the_command_learns_from_a_houses_file_anywhere_and_round_trips(tmp_path, capsys):
-    with gzip.open(SHARED, "rt", encoding="utf-8") as fh:
-        lines = [next(fh) for _ in range(2)]
-    houses = tmp_path / "elsewhere" / "two.jsonl.gz"
-    houses.parent.mkdir()
-    with gzip.open(houses, "wt", encoding="utf-8") as fh:
-        fh.writelines(lines)
+    houses = houses_elsewhere(SHARED, tmp_path, 2, "two.jsonl.gz")
     out = tmp_path / "prior.json"
     assert cli_main(["room-prior", "--houses", str(houses), "--out", str(out)]) == 0
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])

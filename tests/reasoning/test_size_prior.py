@@ -3,7 +3,6 @@ relations it keeps open on a memory box seen in part."""
 
 from __future__ import annotations
 
-import gzip
 import json
 from pathlib import Path
 from types import SimpleNamespace
@@ -16,6 +15,7 @@ from hiconav.reasoning import size_prior
 from hiconav.reasoning.grounding import could_hold, ground, grown_toward
 from hiconav.reasoning.size_prior import SizePrior, from_json, learn, load
 
+from .helpers import houses_elsewhere
 from .test_grounding import node
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "procthor" / "train.jsonl.gz"
@@ -119,12 +119,7 @@ def test_rooms_are_not_grown():
 
 @pytest.mark.skipif(not SHARED.is_file(), reason="needs ../shared/data/procthor/train.jsonl.gz")
 def test_the_command_learns_from_a_houses_file_anywhere_and_round_trips(tmp_path, capsys):
-    with gzip.open(SHARED, "rt", encoding="utf-8") as fh:
-        lines = [next(fh) for _ in range(3)]
-    houses = tmp_path / "elsewhere" / "three.jsonl.gz"
-    houses.parent.mkdir()
-    with gzip.open(houses, "wt", encoding="utf-8") as fh:
-        fh.writelines(lines)
+    houses = houses_elsewhere(SHARED, tmp_path, 3, "three.jsonl.gz")
     out = tmp_path / "sizes.json"
     assert cli_main(["size-prior", "--houses", str(houses), "--out", str(out), "--min-count", "1"]) == 0
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
