@@ -270,10 +270,6 @@ class Goal:
     # half a step from it, or a forward step is blocked: the last centimetres of a creep, where the
     # map's cells and margins are coarser than the gap left (see ``Navigator``)
     straight: bool = False
-    # camera pitch (rad, positive up) to hold once at the goal, facing its yaw: a look up at the
-    # wall above something. Every other goal levels the camera first (discrete control with a
-    # tilting camera, Habitat's look_up / look_down; a fixed camera skips it)
-    tilt: float = 0.0
 
     @property
     def xy(self) -> np.ndarray:

@@ -78,9 +78,6 @@ class ExploreSettings(_Section):
                            0, 100)
     linger_m: float = _f(1.5, "an instance within this of the robot's footprint distance is close enough to "
                               "linger by (m)", 0.0, 10.0)
-    linger_look_up_deg: float = _f(30.0, "beside an undecided instance described by what is above it (the bed "
-                                         "below the painting), first look up this much facing it (degrees; a "
-                                         "multiple of planning.discrete.tilt_deg; 0: never)", 0.0, 60.0)
     last_resort: bool = _f(True, "explored out with a candidate set aside only as out of reach (no view point or "
                                  "approach cell it could reach): stop as near the best of it as the map allows "
                                  "rather than fail (hiconav.decisions.last_resort)")

@@ -114,7 +114,6 @@ class FrontierGoal:
     yaw: float | None
     tolerance: float
     frontier: int | None = None
-    tilt: float = 0.0  # a look's camera pitch (rad, up positive; ``Goal.tilt``)
     through_unknown: bool = False
 
 

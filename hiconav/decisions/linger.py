@@ -8,28 +8,18 @@ drives on with the exploration plan, and when the verdict comes, a few seconds l
 Turning in place beside it instead shows the memory the instance and its surroundings, from
 where a related object next to it would be seen, at the cost of a few turns and no path.
 
-An instance described by what hangs above it ("the bed below the painting") is the one case the
-turns do not serve: within the 1.5 m it lingers at, the level camera sees nothing higher than
-about 1.8 m, so the painting never enters the memory from there. Facing the instance, the robot
-first looks up one tilt step (``look_up_goal``), where the wall above it is in view.
-
-Pure: plain memory objects in, an object id or a goal out. The Explore behaviour sends the turns.
+Pure: plain memory objects in, an object id out. The Explore behaviour sends the turns.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Collection, Iterable
 from typing import Any
 
 import numpy as np
 
-from hiconav.decisions.frontiers import LOOK_TOLERANCE_M, FrontierGoal
 from hiconav.geometry import footprint_distance
-from hiconav.types import Pose2D, label_key
-
-#: relations of a target to something above it, whose words people use for a thing hung over it
-ABOVE_IT = frozenset({"under", "below", "beneath", "underneath"})
+from hiconav.types import label_key
 
 
 def undecided_near(objects: Iterable[Any], targets: Iterable[str], robot_xy: np.ndarray, within_m: float,
@@ -53,19 +43,4 @@ def undecided_near(objects: Iterable[Any], targets: Iterable[str], robot_xy: np.
     return None if best is None else best[1]
 
 
-def told_by_what_is_above(relations: Iterable[Any], targets: Iterable[str]) -> bool:
-    """Whether a relation of a target (subject one of ``targets``) names something above it
-    ("the bed below the painting", "the chair under the TV")."""
-    keys = {label_key(t) for t in targets}
-    return any(label_key(str(s)) in keys and str(r).strip().lower() in ABOVE_IT for s, r, *_ in relations)
-
-
-def look_up_goal(pose: Pose2D, obj: Any, tilt: float) -> FrontierGoal:
-    """A look in place, facing the centre of ``obj``'s footprint (its ``box_min`` / ``box_max``),
-    with the camera pitched up by ``tilt`` rad."""
-    c = (np.asarray(obj.box_min, dtype=np.float64)[:2] + np.asarray(obj.box_max, dtype=np.float64)[:2]) / 2.0
-    yaw = math.atan2(c[1] - pose.y, c[0] - pose.x)
-    return FrontierGoal("look", pose.x, pose.y, yaw, LOOK_TOLERANCE_M, tilt=float(tilt))
-
-
-__all__ = ["ABOVE_IT", "look_up_goal", "told_by_what_is_above", "undecided_near"]
+__all__ = ["undecided_near"]

@@ -38,7 +38,6 @@ class DiscreteConfig(BaseModel):
     )
     forward_step_m: float = Field(0.25, gt=0.0)
     turn_deg: float = Field(30.0, gt=0.0)
-    tilt_deg: float = Field(30.0, gt=0.0, description="camera pitch per look_up / look_down action")
     lookahead_m: float = Field(0.4, gt=0.0, description="steer toward the path point this far ahead")
 
 

@@ -123,7 +123,6 @@ class Navigator:
         self._elapsed = 0.0
         self.n_plans = 0
         self.n_recoveries = 0
-        self.camera_tilt = 0.0  # rad: the pitch commanded by look_up / look_down since made
         self.tight = False  # the current path uses a tight passage (robot radius clear, no margin)
         self.squeeze = False  # ... one cell tighter still (``squeeze_mask``; implies ``tight``)
 
@@ -393,10 +392,6 @@ class Navigator:
         if self.goal is None:
             self.status = "idle"
             return self._act(DiscreteAction.STOP, pose)
-        if self.camera_tilt != 0.0 and self.goal.tilt == 0.0:
-            # the camera is tilted from a look: level it before anything else (the map and the
-            # detector expect a level camera on the move)
-            return self._act(self._tilt_action(0.0), pose)
         if self.goal.straight:
             return self._step_straight(grid, pose)
         # stuck detection: a forward step that did not move the robot
@@ -427,9 +422,6 @@ class Navigator:
                 turn = heading_action(pose, self.goal.yaw, cfg.discrete.turn_tolerance_deg)
                 if turn is not None:
                     return self._act(turn, pose)
-            tilt = self._tilt_action(self.goal.tilt)
-            if tilt is not None:
-                return self._act(tilt, pose)
             self.reached = True
             self.status = "reached"
             return self._act(DiscreteAction.STOP, pose)
@@ -523,17 +515,6 @@ class Navigator:
             return False
         end = pose.xy + step * heading
         return float(np.min(np.hypot(*(path - end).T))) <= 0.3
-
-    def _tilt_action(self, want: float) -> DiscreteAction | None:
-        """LOOK_UP / LOOK_DOWN toward the camera pitch ``want`` (rad), counted as sent (the camera's
-        pitch is the sum of the tilts commanded since the navigator was made); None when within
-        half a tilt step of it."""
-        step = math.radians(self.config.discrete.tilt_deg)
-        if abs(want - self.camera_tilt) < 0.5 * step:
-            return None
-        up = want > self.camera_tilt
-        self.camera_tilt += step if up else -step
-        return DiscreteAction.LOOK_UP if up else DiscreteAction.LOOK_DOWN
 
     def _act(self, action: DiscreteAction, pose: Pose2D) -> DiscreteAction:
         self._last_action = action

@@ -455,23 +455,3 @@ def test_the_navigator_goes_on_after_a_non_finite_pose():
     grid = snapshot(open_room())
     nav.step(grid, Pose2D(1.0, 1.0, math.nan))
     assert nav.step(grid, Pose2D(1.0, 1.0, 0.0)) == DiscreteAction.MOVE_FORWARD
-
-
-def test_a_look_with_a_tilt_faces_its_yaw_then_pitches_the_camera_and_the_next_goal_levels_it_first():
-    grid = snapshot(open_room())
-    nav = Navigator()
-    pose = Pose2D(2.5, 2.5, 0.0)
-    nav.set_goal(Goal(2.5, 2.5, yaw=math.pi / 2, tolerance=0.5, kind="look", tilt=math.radians(30)))
-    actions = [nav.step(grid, pose)]
-    assert actions == [DiscreteAction.TURN_LEFT]  # the yaw first
-    pose = Pose2D(2.5, 2.5, math.pi / 2)
-    actions = [nav.step(grid, pose) for _ in range(2)]
-    assert actions == [DiscreteAction.LOOK_UP, DiscreteAction.STOP] and nav.reached
-    assert nav.camera_tilt == pytest.approx(math.radians(30))
-    nav.set_goal(Goal(2.5, 4.0, tolerance=0.25))  # on the move: level the camera before anything else
-    assert nav.step(grid, pose) == DiscreteAction.LOOK_DOWN and nav.camera_tilt == pytest.approx(0.0)
-    assert nav.step(grid, pose) == DiscreteAction.MOVE_FORWARD
-    nav.set_goal(Goal(2.5, 4.0, tolerance=0.25, tilt=math.radians(60)))  # two steps of 30 degrees
-    pose = Pose2D(2.5, 4.0, math.pi / 2)
-    assert [nav.step(grid, pose) for _ in range(3)] == [DiscreteAction.LOOK_UP, DiscreteAction.LOOK_UP,
-                                                          DiscreteAction.STOP]

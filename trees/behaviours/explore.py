@@ -8,8 +8,6 @@ pose, the state of the goal in flight, the mission's record of exploration), ask
 
 from __future__ import annotations
 
-import math
-
 from hiconav.decisions import linger
 from hiconav.decisions.frontiers import ExploreLedger, FrontierFollower, FrontierGoal, PlanView, look_goal
 from hiconav.trees.behaviours.base import MissionBehaviour, Status
@@ -95,12 +93,7 @@ class Explore(MissionBehaviour):
         ctx.lingered.add(oid)
         ctx.log(f"Explore: turning beside undecided #{oid}")
         self._lingering, self._turns, ctx.last_frontier_time = oid, 0, ctx.now()
-        node = ctx.object(oid) if s.linger_look_up_deg > 0 else None
-        if node is not None and linger.told_by_what_is_above(ctx.task.relations, ctx.task.targets):
-            self._turns = -1  # a look up at the wall above it first, then the turns
-            self._seq = ctx.send_goal(_goal(linger.look_up_goal(pose, node, math.radians(s.linger_look_up_deg))))
-        else:
-            self._seq = ctx.send_goal(_goal(look_goal(pose)))
+        self._seq = ctx.send_goal(_goal(look_goal(pose)))
         self.feedback_message = f"looking around #{oid}"
         return True
 
@@ -121,6 +114,6 @@ class Explore(MissionBehaviour):
 def _goal(goal: FrontierGoal) -> Goal:
     """The control layer's goal for a frontier-following goal (a look is a "look" goal)."""
     if goal.kind == "look":
-        return Goal(goal.x, goal.y, goal.yaw, goal.tolerance, "look", tilt=goal.tilt)
+        return Goal(goal.x, goal.y, goal.yaw, goal.tolerance, "look")
     return Goal(goal.x, goal.y, goal.yaw, goal.tolerance, "frontier", goal.frontier,
                 through_unknown=goal.through_unknown)
