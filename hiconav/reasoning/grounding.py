@@ -333,8 +333,8 @@ def ground(candidate: BoxLike, objects: Sequence[BoxLike], relations: Sequence[S
 
 
 def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relations: Sequence[Sequence[str]],
-         rooms: dict[int, tuple[str | None, float]], depth: int,
-         sizes: Mapping[str, tuple[float, float]] | None = None) -> tuple[str, str]:
+         rooms: dict[int, tuple[str | None, float]], depth: int, *,
+         sizes: Mapping[str, tuple[float, float]]) -> tuple[str, str]:
     room = room_of(obj)
     if room is None and label_key(obj) in UNINFERRED_ROOMS:
         # "the table in the dining room": a room type the room prior does not tell apart; waiting
@@ -358,7 +358,7 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
     for other in sorted(others, key=lambda o: planar_gap(node, o)):
         grade = relation_grade(rel, node, other)
         if grade == "fails":
-            if partial is None and sizes and could_hold(rel, node, other, sizes):
+            if partial is None and could_hold(rel, node, other, sizes):
                 partial = other
             continue
         if nested:

@@ -101,7 +101,8 @@ def from_json(data: Any, path: str = "") -> SizePrior:
         if pair[1] > pair[0]:
             raise ValueError(f"{where}: sizes.{cat}: 'short' ({pair[1]}) is longer than 'long' ({pair[0]})")
         sizes[str(cat)] = (pair[0], pair[1])
-        counts[str(cat)] = int(v.get("n", 0)) if isinstance(v.get("n", 0), int) else 0
+        n = v.get("n", 0)
+        counts[str(cat)] = int(n) if isinstance(n, int) else 0
     return SizePrior(sizes, counts, str(data.get("source", "")))
 
 
