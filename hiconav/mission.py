@@ -480,6 +480,10 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
                                           if e["kind"] == "verify" or (e["kind"] == "unresolved" and e["found"]))),
                "feedback": result.mission_feedback,
                "shortest_to_success": float(m.shortest_to_success),  # SPL's l (docs/evaluation.md)
+               "goal_in_view": None if m.steps_to_view is None else {
+                   "steps": int(m.steps_to_view), "path_m": float(m.path_to_view),
+                   "to_success_m": None if m.view_to_success is None or not math.isfinite(m.view_to_success)
+                   else float(m.view_to_success)},
                "dropped": {k: dict(v.dropped) for k, v in result.stats.items() if v.dropped}})
 
 

@@ -152,6 +152,21 @@ def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
                "stepped clock's 0.1 s ticks is 0.4 s (`mission.latency_time: clock` takes it in clock "
                "seconds). Task times show what asynchrony buys (compare the sync_reasoning preset)."), ""]
 
+    split = [(name, g["path"]) for name, g in presets.items() if g.get("path", {}).get("successes_measured")]
+    if split:
+        lines += ["## Where the path goes", ""]
+        rows = [[name, str(p["successes_measured"]), _num(p["shortest_m"], 0), _num(p["driven_m"], 0),
+                 _num(p["before_view_m"], 0), _pct(p["before_view_share"]),
+                 f"{_num(p.get('after_view_m'), 0)} / {_num(p.get('after_view_shortest_m'), 0)}",
+                 f"{p['failures_never_in_view']} / {p['failures_measured']}"] for name, p in split]
+        lines += _table(["Preset", "Successes", "Shortest (m)", "Driven (m)", "Before the goal in view (m)",
+                         "Share (%)", "After: driven / shortest (m)", "Failures never in view"], rows)
+        lines += [("Over the successes: SPL's shortest paths, the path driven, and the part driven before a "
+                   "goal instance first covered 150 pixels within the depth range (the simulator's ground "
+                   "truth, not what the detector reported); after it, the path driven against the shortest "
+                   "path from that spot to the success region. Before the view is exploration; after it, "
+                   "detection, verification and the approach."), ""]
+
     if main is not None and presets.get(main, {}).get("by_target"):
         lines += [f"## Success by target category ({main})", ""]
         rows = [[t, str(v["episodes"]), _pct(v["success_rate"]), _pct(v["spl"])]

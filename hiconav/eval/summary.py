@@ -43,6 +43,31 @@ def _mean(values: Sequence[float]) -> float | None:
     return float(sum(values) / len(values)) if values else None
 
 
+def path_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
+    """Where the path of the successes went: before a goal was first in view within the depth
+    range (``extra["goal_in_view"]``, the simulator's ground truth) and after, against SPL's
+    shortest paths; and the failures whose goal never came in view. Records without the field
+    (older runs, robots) are left out (``successes_measured``)."""
+    wins = [r for r in records if r.success and "goal_in_view" in r.extra]
+    seen = [r for r in wins if r.extra["goal_in_view"] is not None]
+    fails = [r for r in records if not r.success and "goal_in_view" in r.extra]
+    before = float(sum(r.extra["goal_in_view"]["path_m"] for r in seen))
+    driven = float(sum(r.path_length for r in seen))
+    known = [r for r in seen if r.extra["goal_in_view"].get("to_success_m") is not None]
+    return {
+        "successes_measured": len(wins),
+        "driven_m": driven,
+        "shortest_m": float(sum(float(r.extra.get("shortest_to_success", 0.0)) for r in seen)),
+        "before_view_m": before,
+        "before_view_share": before / driven if driven > 0 else None,
+        # after the view: driven from there, and the shortest path from there to the success region
+        "after_view_m": float(sum(r.path_length - r.extra["goal_in_view"]["path_m"] for r in known)),
+        "after_view_shortest_m": float(sum(r.extra["goal_in_view"]["to_success_m"] for r in known)),
+        "failures_measured": len(fails),
+        "failures_never_in_view": sum(1 for r in fails if r.extra["goal_in_view"] is None),
+    }
+
+
 def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
     """Metrics of one set of records (one preset)."""
     valid = [r for r in records if r.failure != Failure.INVALID_EPISODE.value]
@@ -73,6 +98,7 @@ def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
         "layers": layers,
     }
     by_target: dict[str, dict[str, Any]] = {}
+    path = path_split(valid)
     for target in sorted({r.target for r in valid}):
         group = [r for r in valid if r.target == target]
         by_target[target] = {"episodes": len(group),
@@ -92,6 +118,7 @@ def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
         "failures": failures,
         "failure_rates": {c: (n / len(records) if records else 0.0) for c, n in failures.items()},
         "timing": timing,
+        "path": path,
         "by_target": by_target,
         "detectors": sorted({r.detector for r in valid if r.detector}),
         "reasoners": sorted({r.reasoner for r in valid if r.reasoner}),

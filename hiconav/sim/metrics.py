@@ -18,6 +18,8 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import Any
 
+import numpy as np
+
 from hiconav.sim.config import SimConfig
 from hiconav.sim.episodes import Episode
 from hiconav.sim.geodesic import GoalDistance
@@ -53,6 +55,12 @@ class EpisodeMetrics:
     collisions: int
     stopped: bool
     shortest_to_success: float = 0.0  # geodesic start to success-region distance: SPL's l (m)
+    # the first frame with a goal instance in view within the depth range (Simulator.watch):
+    # actions and path length (m) before it, and the geodesic distance (m) from where the robot
+    # stood then to the success region; None when no goal was ever in view
+    steps_to_view: int | None = None
+    path_to_view: float | None = None
+    view_to_success: float | None = None
 
     def to_json(self) -> dict[str, Any]:
         return asdict(self)
@@ -61,12 +69,16 @@ class EpisodeMetrics:
 def episode_metrics(episode: Episode, *, final_distance: float, path_length: float,
                     steps: int, stopped: bool, shortest_to_success: float, collisions: int = 0,
                     config: SimConfig | None = None,
-                    final_to_success: float | None = None) -> EpisodeMetrics:
+                    final_to_success: float | None = None,
+                    first_in_view: tuple[int, float] | None = None,
+                    view_to_success: float | None = None) -> EpisodeMetrics:
     """Score an episode from its end state (hand-made cases in tests use this directly).
 
     ``shortest_to_success``: the geodesic distance from the start to the success region (SPL's l;
     ``GoalDistance.to_success``); ``final_to_success``: the same from where the robot ended (the
-    DTS; when None, ``final_distance - success_distance``, a lower bound of it)."""
+    DTS; when None, ``final_distance - success_distance``, a lower bound of it); ``first_in_view``:
+    (steps, path length) when a goal was first in view (``Simulator.first_in_view``), and
+    ``view_to_success`` the geodesic distance from there to the success region."""
     cfg = config or SimConfig()
     success = bool(stopped and steps <= cfg.max_steps and
                    final_distance <= cfg.success_distance)
@@ -77,7 +89,10 @@ def episode_metrics(episode: Episode, *, final_distance: float, path_length: flo
         else max(0.0, float(final_to_success)), final_distance=float(final_distance),
         shortest=float(episode.geodesic_distance), path_length=float(path_length),
         steps=int(steps), collisions=int(collisions), stopped=bool(stopped),
-        shortest_to_success=float(shortest_to_success))
+        shortest_to_success=float(shortest_to_success),
+        steps_to_view=None if first_in_view is None else int(first_in_view[0]),
+        path_to_view=None if first_in_view is None else float(first_in_view[1]),
+        view_to_success=None if first_in_view is None or view_to_success is None else float(view_to_success))
 
 
 class EpisodeTracker:
@@ -88,6 +103,8 @@ class EpisodeTracker:
         self.episode = episode
         self.goal = GoalDistance(sim.house, episode, radius=sim.config.robot_radius)
         self.shortest_to_success = self.goal.to_success(episode.start.xy, sim.config.success_distance)
+        if hasattr(sim, "watch"):
+            sim.watch(episode.goal_instance_ids)
 
     @property
     def done(self) -> bool:
@@ -95,8 +112,11 @@ class EpisodeTracker:
 
     def finish(self) -> EpisodeMetrics:
         sim = self.sim
+        view = getattr(sim, "first_in_view", None)
+        to_view = None if view is None else self.goal.to_success(np.array(view[2:4]), sim.config.success_distance)
         return episode_metrics(self.episode, final_distance=self.goal.distance(sim.pose.xy),
                                path_length=sim.path_length, steps=sim.steps,
                                stopped=sim.stopped, collisions=sim.collisions,
                                shortest_to_success=self.shortest_to_success, config=sim.config,
-                               final_to_success=self.goal.to_success(sim.pose.xy, sim.config.success_distance))
+                               final_to_success=self.goal.to_success(sim.pose.xy, sim.config.success_distance),
+                               first_in_view=None if view is None else view[:2], view_to_success=to_view)

@@ -62,6 +62,8 @@ class Simulator:
         self.collisions = 0
         self.stopped = False
         self._seq = 0
+        self._watch: np.ndarray | None = None  # instance ids whose first sighting is recorded
+        self.first_in_view: tuple[int, float, float, float] | None = None  # (steps, path m, x, y) then
 
     # ----------------------------------------------------------------------------- state
     def is_free(self, xy: np.ndarray) -> bool:
@@ -106,6 +108,7 @@ class Simulator:
         self.path_length = 0.0
         self.collisions = 0
         self.stopped = False
+        self.first_in_view = None
         return self.observe()
 
     # ----------------------------------------------------------------------------- motion
@@ -204,10 +207,40 @@ class Simulator:
     def T_world_cam(self) -> np.ndarray:
         return camera_pose_from_base(self.pose, self.config.camera_height, self.tilt)
 
+    def watch(self, instance_ids) -> None:
+        """Record (``first_in_view``) the first rendered frame in which one of ``instance_ids``
+        covers ``MIN_VIEW_PIXELS`` pixels within the depth range (what the robot could map): where
+        an episode's path went before its goal was first in view, and after. Scoring only; the
+        robot never sees it."""
+        self._watch = np.asarray(sorted({int(i) for i in instance_ids}), dtype=np.int64)
+        self.first_in_view = None
+        if self._renderer is not None:  # the view the robot stands in now counts too
+            _, depth, instances = self._renderer.render(self.T_world_cam, self.intrinsics)
+            self._check_in_view(depth, instances)
+
+    def _check_in_view(self, depth: np.ndarray, instances: np.ndarray | None) -> None:
+        from hiconav.sim.viewpoints import MIN_VIEW_PIXELS
+
+        if self._watch is None or self.first_in_view is not None or instances is None or not self._watch.size:
+            return
+        inst = np.asarray(instances)
+        top = int(self._watch.max())
+        lut = np.zeros(top + 3, dtype=bool)  # instance id + 1 -> watched; -1 (none) -> 0, larger ids clip to False
+        lut[self._watch + 1] = True
+        if np.count_nonzero(lut.take(inst[::2, ::2] + 1, mode="clip")) * 4 < MIN_VIEW_PIXELS // 2:
+            return  # a quarter of the pixels holds far too few of them
+        hit = lut.take(inst + 1, mode="clip")
+        if np.count_nonzero(hit) < MIN_VIEW_PIXELS:
+            return
+        d = depth[hit]
+        if np.count_nonzero(np.isfinite(d) & (d > 0) & (d <= self.config.max_depth)) >= MIN_VIEW_PIXELS:
+            self.first_in_view = (int(self.steps), float(self.path_length), float(self.pose.x), float(self.pose.y))
+
     def observe(self) -> Frame:
         """Render the current view (no state change besides the frame counter)."""
         T = self.T_world_cam
         rgb, depth, instances = self.renderer.render(T, self.intrinsics)
+        self._check_in_view(depth, instances)
         self._seq += 1
         return Frame(rgb=rgb, depth=depth, intrinsics=self.intrinsics, T_world_cam=T,
                      base_pose=self.pose, stamp=self.time, instances=instances, seq=self._seq)

@@ -54,3 +54,25 @@ def test_a_report_without_labelled_plots_writes_no_legend_warning(tmp_path, recw
     assert (tmp_path / "report.md").is_file() and (tmp_path / "failures.png").is_file()
     assert [str(w.message) for w in recwarn] == []
     assert capsys.readouterr() == ("", "")
+
+
+
+def test_the_report_says_where_the_path_went_when_records_carry_the_goal_in_view() -> None:
+    from hiconav.eval.records import EpisodeRecord
+    from hiconav.eval.report import render_markdown
+    from hiconav.eval.summary import summarize
+
+    def rec(i: int, success: bool, path: float, **extra) -> EpisodeRecord:
+        return EpisodeRecord(episode_id=f"e{i}", house="h", target="bed", preset="full", success=success,
+                             failure="success" if success else "step_out", spl=0.5 if success else 0.0,
+                             path_length=path, extra={"shortest_to_success": 4.0, **extra})
+
+    records = [rec(0, True, 8.0, goal_in_view={"steps": 9, "path_m": 6.0, "to_success_m": 1.5}),
+               rec(1, False, 50.0, goal_in_view=None)]
+    text = render_markdown(records, summarize(records))
+    assert "## Where the path goes" in text
+    row = next(line for line in text.splitlines() if line.startswith("| full") and "75.0" in line)
+    assert row.split(" | ")[1:5] == ["1", "4", "8", "6"]  # successes, shortest, driven, before the view
+    assert "2 / 2" in row and "1 / 1" in row  # after: driven / shortest; failures never in view
+    older = [rec(2, True, 3.0)]  # records written before the field existed: no such section
+    assert "## Where the path goes" not in render_markdown(older, summarize(older))

@@ -67,3 +67,19 @@ def test_ablation_deltas_are_paired_on_common_episodes_with_sign() -> None:
     assert delta["delta_success_rate"] == pytest.approx(-0.5)
     assert delta["delta_spl"] == pytest.approx(((0.4 - 0.8) + (0.0 - 0.6)) / 2)
     assert s["success_rate"] == pytest.approx(2 / 3)  # top level = the full preset
+
+
+def test_path_split_counts_the_successes_path_before_and_after_the_goal_came_in_view() -> None:
+    view = lambda path, to_success: {"goal_in_view": {"steps": 10, "path_m": path, "to_success_m": to_success}}  # noqa: E731
+    records = [
+        rec(0, success=True, spl=0.5, path_length=10.0, extra={"shortest_to_success": 5.0, **view(6.0, 2.0)}),
+        rec(1, success=True, spl=1.0, path_length=3.0, extra={"shortest_to_success": 3.0, **view(0.0, 3.0)}),
+        rec(2, success=True, spl=1.0, path_length=3.0),  # an older record: no such field
+        rec(3, success=False, spl=0.0, path_length=40.0, extra={"goal_in_view": None}),
+        rec(4, success=False, spl=0.0, path_length=40.0, extra=view(30.0, 4.0)),
+    ]
+    p = summarize(records)["path"]
+    assert p["successes_measured"] == 2 and p["failures_measured"] == 2 and p["failures_never_in_view"] == 1
+    assert p["driven_m"] == pytest.approx(13.0) and p["shortest_m"] == pytest.approx(8.0)
+    assert p["before_view_m"] == pytest.approx(6.0) and p["before_view_share"] == pytest.approx(6.0 / 13.0)
+    assert p["after_view_m"] == pytest.approx(7.0) and p["after_view_shortest_m"] == pytest.approx(5.0)

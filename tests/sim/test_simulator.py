@@ -136,3 +136,32 @@ def test_observation_frame_fields():
     f2 = sim.step(A.MOVE_FORWARD)
     assert f2.seq == f.seq + 1 and f2.stamp > f.stamp
     sim.close()
+
+
+def test_the_first_frame_with_a_goal_in_view_is_recorded_with_the_path_before_it():
+    """Scoring only: where an episode's path went before its goal was first in view."""
+    house = box_room(10.0, [obj(2, "bed", (8.0, 5.0, 0.3), (1.6, 2.0, 0.6)),
+                            obj(1, "chair", (2.0, 8.5, 0.45), (0.5, 0.5, 0.9))])
+    sim = Simulator(house, SimConfig(width=160, height=120))
+    sim.reset(Pose2D(2.0, 5.0, math.pi))  # facing away from the bed
+    sim.watch([2])
+    assert sim.first_in_view is None
+    sim.step(A.MOVE_FORWARD)  # 0.25 m, still facing the wall behind
+    for _ in range(6):  # turn round toward the bed, 5.45 m off: in range at the image's edge
+        sim.step(A.TURN_LEFT)  # (depth is measured along the optical axis, as a depth camera's)
+    assert sim.first_in_view is not None
+    steps, path, x, y = sim.first_in_view
+    assert 1 < steps <= 7 and path == pytest.approx(0.25) and (x, y) == pytest.approx((1.75, 5.0))
+    sim.step(A.MOVE_FORWARD)
+    sim.step(A.MOVE_FORWARD)
+    assert sim.first_in_view[0] == steps  # the first sighting stays
+    sim.watch([2])  # watching anew: the goal in view where the robot stands counts at once
+    assert sim.first_in_view is not None and sim.first_in_view[0] == sim.steps
+    sim.watch([1])  # the chair is to the robot's left, out of the image; the bed's larger id is not it
+    assert sim.first_in_view is None
+    sim.close()
+    far = Simulator(house, SimConfig(width=160, height=120, max_depth=3.0))
+    far.reset(Pose2D(2.0, 5.0, 0.0))  # facing the bed 5.2 m off, beyond a 3 m depth range
+    far.watch([2])
+    assert far.first_in_view is None
+    far.close()
