@@ -12,6 +12,12 @@ test on those, and the paired SPL difference with its bootstrap interval
     {"paired": N, "before": {"sr", "sr_ci95", "spl"}, "after": {...}, "up": U, "down": D,
      "sign_test_p": p, "delta_sr": x, "delta_spl": y, "delta_spl_ci95": [lo, hi], ...}
 
+When both runs' records say where the path went (``extra.goal_in_view``, docs/evaluation.md), a
+line before the JSON splits the path of the episodes that succeeded in both at the first frame
+with a goal in view, so that a change is seen moving exploration (before) or verification and
+the approach (after); the JSON gains ``"path": {"episodes", "before_view_m": [before, after],
+"after_view_m": [before, after]}``.
+
 A change whose ``up`` and ``down`` a sign test cannot tell apart (p well above 0.05) has not been
 shown to do anything: four up and one down is p = 0.375, however many episodes ran. It reads
 files only.
@@ -61,6 +67,28 @@ def _line(r: Any) -> str:
     return f"{r.failure:15s} {r.steps:4d} {float(r.spl):.2f}"
 
 
+def _view(r: Any) -> dict[str, Any] | None:
+    v = r.extra.get("goal_in_view") if isinstance(r.extra, dict) else None
+    return v if isinstance(v, dict) and v.get("path_m") is not None else None
+
+
+def path_split(by_a: dict[str, Any], by_b: dict[str, Any]) -> dict[str, Any] | None:
+    """Path before / after the first frame with a goal in view, summed over the episodes that
+    succeeded in both runs with the field in both; None when no episode has it."""
+    both = [(by_a[e], by_b[e]) for e in sorted(set(by_a) & set(by_b))
+            if by_a[e].success and by_b[e].success and _view(by_a[e]) and _view(by_b[e])]
+    if not both:
+        return None
+
+    def before(r: Any) -> float:
+        return float(_view(r)["path_m"])
+
+    return {"episodes": len(both),
+            "before_view_m": [sum(before(ra) for ra, _ in both), sum(before(rb) for _, rb in both)],
+            "after_view_m": [sum(float(ra.path_length) - before(ra) for ra, _ in both),
+                             sum(float(rb.path_length) - before(rb) for _, rb in both)]}
+
+
 def compare(before: Path, after: Path, preset: str | None = None, preset_after: str | None = None
             ) -> tuple[dict[str, Any], list[str]]:
     """The paired comparison of two runs and the printed lines of the episodes that changed."""
@@ -68,6 +96,9 @@ def compare(before: Path, after: Path, preset: str | None = None, preset_after: 
     b = _records(after, preset_after if preset_after is not None else preset)
     result = paired_comparison(a, b)
     by_a, by_b = {r.episode_id: r for r in a}, {r.episode_id: r for r in b}
+    split = path_split(by_a, by_b)
+    if split is not None:
+        result["path"] = split
     lines = []
     for eid in sorted(set(by_a) & set(by_b)):
         ra, rb = by_a[eid], by_b[eid]
@@ -101,6 +132,11 @@ def main(argv: list[str] | None = None) -> int:
         lo, hi = result["delta_spl_ci95"]
         print(f"up {result['up']}, down {result['down']}: sign test p = {result['sign_test_p']:.3f}; "
               f"dSPL {_pct(result['delta_spl'])} pts [{_pct(lo)}, {_pct(hi)}]")
+    if "path" in result:
+        p = result["path"]
+        print(f"path of the {p['episodes']} successes in both: before a goal in view "
+              f"{p['before_view_m'][0]:.1f} -> {p['before_view_m'][1]:.1f} m, after "
+              f"{p['after_view_m'][0]:.1f} -> {p['after_view_m'][1]:.1f} m")
     print(json.dumps({k: v for k, v in result.items() if k not in ("up_ids", "down_ids")}))
     return 0
 

@@ -103,3 +103,23 @@ def test_compare_names_the_file_when_a_preset_is_missing_or_ambiguous(tmp_path, 
     (tmp_path / "binary.jsonl").write_bytes(b"\xff\xfe\x00garbage\n")
     assert compare_main([str(tmp_path / "binary.jsonl"), str(tmp_path / "run"), "--preset", "full"]) == 2
     assert "cannot read episode records" in capsys.readouterr().err
+
+
+def test_compare_splits_the_path_of_the_episodes_both_runs_won_at_the_goal_in_view(tmp_path, capsys) -> None:
+    from dataclasses import replace
+
+    def viewed(r, path: float, before: float):
+        return replace(r, path_length=path, extra={"goal_in_view": {"steps": 5, "path_m": before, "to_success_m": 1.0}})
+
+    a = [viewed(rec(0, True, 0.5), 10.0, 6.0), viewed(rec(1, True, 0.5), 8.0, 2.0), viewed(rec(2, False), 40.0, 30.0)]
+    b = [viewed(rec(0, True, 0.5), 7.0, 3.0), rec(1, True, 0.5), viewed(rec(2, True, 0.2), 20.0, 15.0)]
+    _write(tmp_path / "a", a)
+    _write(tmp_path / "b", b)
+    assert compare_main([str(tmp_path / "a"), str(tmp_path / "b")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    # only e0 won in both with the field in both: e1's second record predates it, e2 failed before
+    assert json.loads(out[-1])["path"] == {"episodes": 1, "before_view_m": [6.0, 3.0], "after_view_m": [4.0, 4.0]}
+    assert "before a goal in view 6.0 -> 3.0 m, after 4.0 -> 4.0 m" in out[-2]
+    _write(tmp_path / "c", [rec(0, True, 0.5)])
+    assert compare_main([str(tmp_path / "c"), str(tmp_path / "c")]) == 0
+    assert "path" not in json.loads(capsys.readouterr().out.splitlines()[-1])
