@@ -35,6 +35,7 @@ from hiconav.errors import DataError
 from hiconav.eval.records import read_records
 from hiconav.eval.runner import EPISODES_FILE
 from hiconav.eval.stats import paired_comparison
+from hiconav.eval.summary import goal_view
 
 
 def _records(path: Path, preset: str | None) -> list[Any]:
@@ -67,26 +68,17 @@ def _line(r: Any) -> str:
     return f"{r.failure:15s} {r.steps:4d} {float(r.spl):.2f}"
 
 
-def _view(r: Any) -> dict[str, Any] | None:
-    v = r.extra.get("goal_in_view") if isinstance(r.extra, dict) else None
-    return v if isinstance(v, dict) and v.get("path_m") is not None else None
-
-
-def path_split(by_a: dict[str, Any], by_b: dict[str, Any]) -> dict[str, Any] | None:
+def paired_path_split(by_a: dict[str, Any], by_b: dict[str, Any]) -> dict[str, Any] | None:
     """Path before / after the first frame with a goal in view, summed over the episodes that
-    succeeded in both runs with the field in both; None when no episode has it."""
-    both = [(by_a[e], by_b[e]) for e in sorted(set(by_a) & set(by_b))
-            if by_a[e].success and by_b[e].success and _view(by_a[e]) and _view(by_b[e])]
-    if not both:
+    succeeded in both runs with the field in both (``summary.goal_view``); None when none has it."""
+    pairs = [(by_a[e], by_b[e]) for e in sorted(set(by_a) & set(by_b))
+             if by_a[e].success and by_b[e].success and goal_view(by_a[e]) and goal_view(by_b[e])]
+    if not pairs:
         return None
-
-    def before(r: Any) -> float:
-        return float(_view(r)["path_m"])
-
-    return {"episodes": len(both),
-            "before_view_m": [sum(before(ra) for ra, _ in both), sum(before(rb) for _, rb in both)],
-            "after_view_m": [sum(float(ra.path_length) - before(ra) for ra, _ in both),
-                             sum(float(rb.path_length) - before(rb) for _, rb in both)]}
+    runs = list(zip(*pairs))  # (A's records, B's records)
+    before = [sum(float(goal_view(r)["path_m"]) for r in run) for run in runs]
+    after = [sum(float(r.path_length) for r in run) - b for run, b in zip(runs, before)]
+    return {"episodes": len(pairs), "before_view_m": before, "after_view_m": after}
 
 
 def compare(before: Path, after: Path, preset: str | None = None, preset_after: str | None = None
@@ -96,7 +88,7 @@ def compare(before: Path, after: Path, preset: str | None = None, preset_after: 
     b = _records(after, preset_after if preset_after is not None else preset)
     result = paired_comparison(a, b)
     by_a, by_b = {r.episode_id: r for r in a}, {r.episode_id: r for r in b}
-    split = path_split(by_a, by_b)
+    split = paired_path_split(by_a, by_b)
     if split is not None:
         result["path"] = split
     lines = []

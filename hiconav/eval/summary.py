@@ -43,13 +43,20 @@ def _mean(values: Sequence[float]) -> float | None:
     return float(sum(values) / len(values)) if values else None
 
 
+def goal_view(record: EpisodeRecord) -> dict[str, Any] | None:
+    """A record's ``extra["goal_in_view"]`` (steps, path_m, to_success_m), or None: no goal was in
+    view, or the record predates the field."""
+    view = record.extra.get("goal_in_view") if isinstance(record.extra, dict) else None
+    return view if isinstance(view, dict) and view.get("path_m") is not None else None
+
+
 def path_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
     """Where the path of the successes went: before a goal was first in view within the depth
     range (``extra["goal_in_view"]``, the simulator's ground truth) and after, against SPL's
     shortest paths; and the failures whose goal never came in view. Records without the field
     (older runs, robots) are left out (``successes_measured``)."""
     wins = [r for r in records if r.success and "goal_in_view" in r.extra]
-    seen = [r for r in wins if r.extra["goal_in_view"] is not None]
+    seen = [r for r in wins if goal_view(r) is not None]
     fails = [r for r in records if not r.success and "goal_in_view" in r.extra]
     before = float(sum(r.extra["goal_in_view"]["path_m"] for r in seen))
     driven = float(sum(r.path_length for r in seen))

@@ -23,6 +23,7 @@ from hiconav.errors import HiconavError
 from hiconav.sim.config import SimConfig
 from hiconav.sim.geodesic import centre_free, clearance
 from hiconav.sim.house import House
+from hiconav.sim.viewpoints import MIN_VIEW_PIXELS
 from hiconav.types import (
     CameraIntrinsics,
     DiscreteAction,
@@ -62,7 +63,9 @@ class Simulator:
         self.collisions = 0
         self.stopped = False
         self._seq = 0
-        self._watch: np.ndarray | None = None  # instance ids whose first sighting is recorded
+        # instance id + 1 -> watched (-1, no instance, -> slot 0; larger ids clip to the last, False
+        # slot): the goals whose first sighting is recorded, None when none are
+        self._watch: np.ndarray | None = None
         self.first_in_view: tuple[int, float, float, float] | None = None  # (steps, path m, x, y) then
 
     # ----------------------------------------------------------------------------- state
@@ -212,21 +215,21 @@ class Simulator:
         covers ``MIN_VIEW_PIXELS`` pixels within the depth range (what the robot could map): where
         an episode's path went before its goal was first in view, and after. Scoring only; the
         robot never sees it."""
-        self._watch = np.asarray(sorted({int(i) for i in instance_ids}), dtype=np.int64)
+        ids = np.asarray(sorted({int(i) for i in instance_ids}), dtype=np.int64)
+        self._watch = None
+        if ids.size:
+            self._watch = np.zeros(int(ids.max()) + 3, dtype=bool)
+            self._watch[ids + 1] = True
         self.first_in_view = None
         if self._renderer is not None:  # the view the robot stands in now counts too
             _, depth, instances = self._renderer.render(self.T_world_cam, self.intrinsics)
             self._check_in_view(depth, instances)
 
     def _check_in_view(self, depth: np.ndarray, instances: np.ndarray | None) -> None:
-        from hiconav.sim.viewpoints import MIN_VIEW_PIXELS
-
-        if self._watch is None or self.first_in_view is not None or instances is None or not self._watch.size:
+        lut = self._watch
+        if lut is None or self.first_in_view is not None or instances is None:
             return
         inst = np.asarray(instances)
-        top = int(self._watch.max())
-        lut = np.zeros(top + 3, dtype=bool)  # instance id + 1 -> watched; -1 (none) -> 0, larger ids clip to False
-        lut[self._watch + 1] = True
         if np.count_nonzero(lut.take(inst[::2, ::2] + 1, mode="clip")) * 4 < MIN_VIEW_PIXELS // 2:
             return  # a quarter of the pixels holds far too few of them
         hit = lut.take(inst + 1, mode="clip")
