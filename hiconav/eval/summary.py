@@ -58,9 +58,9 @@ def path_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
     wins = [r for r in records if r.success and "goal_in_view" in r.extra]
     seen = [r for r in wins if goal_view(r) is not None]
     fails = [r for r in records if not r.success and "goal_in_view" in r.extra]
-    before = float(sum(r.extra["goal_in_view"]["path_m"] for r in seen))
+    before = float(sum(goal_view(r)["path_m"] for r in seen))
     driven = float(sum(r.path_length for r in seen))
-    known = [r for r in seen if r.extra["goal_in_view"].get("to_success_m") is not None]
+    known = [r for r in seen if goal_view(r).get("to_success_m") is not None]
     return {
         "successes_measured": len(wins),
         "driven_m": driven,
@@ -68,8 +68,8 @@ def path_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
         "before_view_m": before,
         "before_view_share": before / driven if driven > 0 else None,
         # after the view: driven from there, and the shortest path from there to the success region
-        "after_view_m": float(sum(r.path_length - r.extra["goal_in_view"]["path_m"] for r in known)),
-        "after_view_shortest_m": float(sum(r.extra["goal_in_view"]["to_success_m"] for r in known)),
+        "after_view_m": float(sum(r.path_length - goal_view(r)["path_m"] for r in known)),
+        "after_view_shortest_m": float(sum(goal_view(r)["to_success_m"] for r in known)),
         "failures_measured": len(fails),
         "failures_never_in_view": sum(1 for r in fails if r.extra["goal_in_view"] is None),
     }

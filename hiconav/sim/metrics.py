@@ -103,8 +103,7 @@ class EpisodeTracker:
         self.episode = episode
         self.goal = GoalDistance(sim.house, episode, radius=sim.config.robot_radius)
         self.shortest_to_success = self.goal.to_success(episode.start.xy, sim.config.success_distance)
-        if hasattr(sim, "watch"):
-            sim.watch(episode.goal_instance_ids)
+        sim.watch(episode.goal_instance_ids)
 
     @property
     def done(self) -> bool:
@@ -112,7 +111,7 @@ class EpisodeTracker:
 
     def finish(self) -> EpisodeMetrics:
         sim = self.sim
-        view = getattr(sim, "first_in_view", None)
+        view = sim.first_in_view
         to_view = None if view is None else self.goal.to_success(np.array(view[2:4]), sim.config.success_distance)
         return episode_metrics(self.episode, final_distance=self.goal.distance(sim.pose.xy),
                                path_length=sim.path_length, steps=sim.steps,

@@ -56,7 +56,6 @@ def test_a_report_without_labelled_plots_writes_no_legend_warning(tmp_path, recw
     assert capsys.readouterr() == ("", "")
 
 
-
 def test_the_report_says_where_the_path_went_when_records_carry_the_goal_in_view() -> None:
     from hiconav.eval.records import EpisodeRecord
     from hiconav.eval.report import render_markdown
