@@ -66,6 +66,10 @@ class MemoryConfig(BaseModel):
                                "so thin or partially seen surfaces can overlap")
     geometric: Literal["iou", "overlap"] = Field(
         "overlap", description="s_g: 'iou' (paper) or 'overlap' = intersection / smaller volume")
+    node_geometry: Literal["majority_label", "all"] = Field(
+        "majority_label", description="a node's points and box: its majority label's observations "
+        "(a one-frame spurious box of another label merged by eq. 4 does not stretch it) or 'all' "
+        "of them (eq. 3's P_j)")
     merge_nodes: bool = Field(True, description="node-node merging as views accumulate")
     update_objects_every_frame: bool = Field(
         False, description="also fold non-anchor frames into object nodes (paper: anchors only)")

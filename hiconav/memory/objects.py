@@ -158,7 +158,15 @@ class ObjectNode:
 
     points: (N, 3) float32 read-only world cloud (replaced, never modified in place, so views
     can share it); label_votes: label -> summed detection score; features: label -> unit
-    embedding of that label.
+    embedding of that label; label_points: label -> the cloud of that label's observations.
+
+    The node's geometry (``points`` and its box) is its majority label's cloud
+    (``MemoryConfig.node_geometry``): eq. (4) also merges observations of another label whose box
+    overlaps the node's (a relabelled view of the same object, whose vote the majority outweighs),
+    and among those are one-frame spurious boxes of another label, a chunk of wall and floor 1-2 m
+    across; the union of the clouds took their extent, and a small plant's node became a 2 m box
+    that the robot stopped 0.9 m from, over 1 m from the plant. With ``"all"`` it is every
+    observation's cloud, as eq. (3) writes P_j.
     """
 
     id: int
@@ -176,6 +184,7 @@ class ObjectNode:
     # every anchor that ever observed it, pruned ones too: which objects one image showed
     # together (co-visibility) outlives the image
     observed_by: set[int] = field(default_factory=set)
+    label_points: dict[str, np.ndarray] = field(default_factory=dict)
     _feature: np.ndarray | None = None
     _view: ObjectView | None = None
 
@@ -186,6 +195,8 @@ class ObjectNode:
                           {obs.label: obs.score}, {obs.label: obs.feature}, 1, obs.score,
                           set(), obs.embedding, stamp)
         node._set_points(obs.points, cfg)
+        if cfg.node_geometry == "majority_label":
+            node.label_points[obs.label] = node.points
         if obs.instance_id is not None:
             node.instance_votes[obs.instance_id] = 1
         return node
@@ -212,18 +223,41 @@ class ObjectNode:
             self._feature = freeze(f / n if n > 0 else f)
         return self._feature
 
-    def _set_points(self, points: np.ndarray, cfg: MemoryConfig) -> None:
+    @staticmethod
+    def _cloud(points: np.ndarray, cfg: MemoryConfig) -> np.ndarray:
+        """Voxelised and capped (evenly spaced subsample, deterministic) read-only cloud."""
         points = voxel_downsample(points, cfg.voxel)
-        if len(points) > cfg.max_points:  # cap: evenly spaced subsample (deterministic)
+        if len(points) > cfg.max_points:
             idx = np.linspace(0, len(points) - 1, cfg.max_points).astype(np.int64)
             points = points[idx]
-        self.points = freeze(points)
-        self.box_min, self.box_max = robust_box(points, cfg.outlier_quantile)
+        return freeze(points)
+
+    def _set_points(self, points: np.ndarray, cfg: MemoryConfig) -> None:
+        self._use_cloud(self._cloud(points, cfg), cfg)
+
+    def _use_cloud(self, cloud: np.ndarray, cfg: MemoryConfig) -> None:
+        self.points = cloud
+        self.box_min, self.box_max = robust_box(cloud, cfg.outlier_quantile)
+
+    def _add_label_cloud(self, label: str, points: np.ndarray, cfg: MemoryConfig) -> None:
+        """Grow ``label``'s cloud by ``points``."""
+        old = self.label_points.get(label)
+        self.label_points[label] = self._cloud(points if old is None else np.concatenate([old, points]), cfg)
+
+    def _use_majority_cloud(self, cfg: MemoryConfig) -> None:
+        """Take the majority label's cloud as the node's geometry (after the votes changed)."""
+        cloud = self.label_points.get(self.label)
+        if cloud is not None and cloud is not self.points:
+            self._use_cloud(cloud, cfg)
 
     def absorb(self, obs: ObjectObservation, stamp: float, cfg: MemoryConfig) -> None:
         """Merge one observation into this node (eq. 4 decided it belongs here)."""
-        self._set_points(np.concatenate([self.points, obs.points]), cfg)
         self.label_votes[obs.label] = self.label_votes.get(obs.label, 0.0) + obs.score
+        if cfg.node_geometry == "majority_label":
+            self._add_label_cloud(obs.label, obs.points, cfg)
+            self._use_majority_cloud(cfg)
+        else:
+            self._set_points(np.concatenate([self.points, obs.points]), cfg)
         self.label_features.setdefault(obs.label, obs.feature)
         self.n_obs += 1
         self.score_sum += obs.score
@@ -240,10 +274,15 @@ class ObjectNode:
 
     def absorb_node(self, other: ObjectNode, cfg: MemoryConfig) -> None:
         """Node-node merge: take over ``other``'s points, votes, observations and anchors."""
-        self._set_points(np.concatenate([self.points, other.points]), cfg)
         for k, w in other.label_votes.items():
             self.label_votes[k] = self.label_votes.get(k, 0.0) + w
             self.label_features.setdefault(k, other.label_features[k])
+        if cfg.node_geometry == "majority_label":
+            for k, cloud in other.label_points.items():
+                self._add_label_cloud(k, cloud, cfg)
+            self._use_majority_cloud(cfg)
+        else:
+            self._set_points(np.concatenate([self.points, other.points]), cfg)
         n0 = self.n_obs
         self.n_obs += other.n_obs
         self.score_sum += other.score_sum
