@@ -51,13 +51,15 @@ class PlanView:
 
     ``frontiers``: objects with ``id``, ``viewpoint`` and ``centroid`` ((2,) world metres);
     ``order``: the WTRP order of frontier ids; ``goal_id``: the plan's goal frontier (None: none);
-    ``stamp``: the clock time the plan was made (s).
+    ``stamp``: the clock time the plan was made (s); ``dropped``: ids of frontiers the planner
+    found no path to on the map's lethal layer (left out of ``order``).
     """
 
     frontiers: tuple[Any, ...]
     order: tuple[int, ...]
     goal_id: int | None
     stamp: float
+    dropped: tuple[int, ...] = ()
 
     @staticmethod
     def of(msg: Any) -> PlanView | None:
@@ -66,7 +68,8 @@ class PlanView:
             return None
         goal = getattr(msg.plan, "goal", None)
         return PlanView(tuple(msg.frontiers), tuple(getattr(msg.plan, "order", ()) or ()),
-                        None if goal is None else goal.id, msg.stamp)
+                        None if goal is None else goal.id, msg.stamp,
+                        tuple(getattr(msg.plan, "dropped", ()) or ()))
 
 
 @dataclass
@@ -103,7 +106,7 @@ class FrontierGoal:
     """A goal of frontier following: world (x, y) m, the yaw to face (None: free), its tolerance.
 
     ``kind``: "frontier" (a viewpoint facing the centroid), "push" (beyond a spent frontier's
-    centroid), "squeeze" (a failed frontier's viewpoint, tried again) or "look" (a quarter turn in
+    centroid), "squeeze" (the viewpoint of a failed frontier, or of one the planner found no path to, tried again) or "look" (a quarter turn in
     place); ``frontier``: the frontier id (None for a look); ``through_unknown``: the path may
     cross floor the map does not know.
     """
@@ -227,24 +230,29 @@ def pick_frontier(plan: PlanView | None, visited: Collection[int], pose: Pose2D 
 
 def pick_squeeze(plan: PlanView | None, ledger: ExploreLedger,
                  s: ExploreSettings) -> tuple[Any, np.ndarray, float | None] | None:
-    """(frontier id, viewpoint, yaw) of the first frontier of the plan's order that failed and was
-    not squeezed yet (its centroid then joins ``ledger.squeezed_frontiers``), or None.
+    """(frontier id, viewpoint, yaw) of the first frontier of the plan's order that failed, else of
+    the first the planner found no path to (``plan.dropped``), that was not squeezed yet (its
+    centroid then joins ``ledger.squeezed_frontiers``), or None.
 
     The map's grid can close a passage the robot fits: a goal through unknown floor lets the
     navigator plan on the lethal layer and then on it one cell thinner, a last resort before
-    "no frontier left"."""
+    "no frontier left". A doorway first seen from across the room is such a passage: the floor
+    seen through it is a narrow wedge, tight at the doorway, and the frontiers along the wedge have
+    no path on the lethal layer, so the planner leaves them out of its order; they are squeezed
+    toward too, after the failed ones."""
     if plan is None or not s.squeeze:
         return None
     frontiers = {f.id: f for f in plan.frontiers}
-    for fid in list(plan.order):
+    failed = [fid for fid in plan.order if fid in ledger.failed_frontiers]
+    for fid in failed + [fid for fid in plan.dropped if fid not in failed]:
         f = frontiers.get(fid)
-        if f is None or fid not in ledger.failed_frontiers:
+        if f is None:
             continue
         centroid = np.asarray(f.centroid, dtype=np.float64)
-        if near_any(centroid, ledger.squeezed_frontiers, s.spent_radius):
+        xy = np.asarray(f.viewpoint, dtype=np.float64)
+        if not np.all(np.isfinite(xy)) or near_any(centroid, ledger.squeezed_frontiers, s.spent_radius):
             continue
         ledger.squeezed_frontiers.append((float(centroid[0]), float(centroid[1])))
-        xy = np.asarray(f.viewpoint, dtype=np.float64)
         return fid, xy, facing_yaw(xy, centroid)
     return None
 

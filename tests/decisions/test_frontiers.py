@@ -110,6 +110,28 @@ def test_a_failed_frontier_is_squeezed_toward_once_per_centroid():
     assert pick_squeeze(plan, _ledger(failed_frontiers={1}), ExploreSettings(squeeze=False)) is None
 
 
+def test_frontiers_the_planner_found_no_path_to_are_squeezed_toward_after_the_failed_ones():
+    """A doorway seen from across the room: the wedge of floor seen through it is tight at the
+    doorway, its frontiers have no path on the lethal layer and are left out of the order."""
+    plan = PlanView((_frontier(0, (1, 0), (2, 0)), _frontier(2, (3, -2), (3, -3)), _frontier(3, (4, -2), (4, -3))),
+                    (0,), None, 0.0, dropped=(3, 2))
+    ledger = _ledger(failed_frontiers={0})
+    assert pick_squeeze(plan, ledger, S)[0] == 0
+    assert pick_squeeze(plan, ledger, S)[0] == 3
+    assert pick_squeeze(plan, ledger, S)[0] == 2
+    assert pick_squeeze(plan, ledger, S) is None
+    # a dropped frontier without a viewpoint is not a goal
+    bare = Frontier(5, np.array([1.0, 1.0]), np.full(2, np.nan), 10)
+    assert pick_squeeze(PlanView((bare,), (), None, 0.0, dropped=(5,)), _ledger(), S) is None
+
+
+def test_an_explored_out_search_squeezes_toward_a_dropped_frontier_before_it_idles():
+    f, ledger = FrontierFollower(), _ledger(start_looks=0, last_frontier_time=0.0)
+    plan = PlanView((_frontier(2, (3, -2), (3, -3)),), (), None, 0.0, dropped=(2,))
+    step = f.step(None, Pose2D(0.0, 0.0, 0.0), 1.0, plan, ledger, (), NO_START)
+    assert step.goal is not None and step.goal.kind == "squeeze" and step.goal.frontier == 2
+
+
 def test_the_start_is_looked_around_in_quarter_turns_before_any_frontier():
     f, ledger = FrontierFollower(), _ledger(start_looks=0)
     plan = _plan(_frontier(0, (1, 0), (2, 0)))
