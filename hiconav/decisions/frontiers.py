@@ -52,7 +52,8 @@ class PlanView:
     ``frontiers``: objects with ``id``, ``viewpoint`` and ``centroid`` ((2,) world metres);
     ``order``: the WTRP order of frontier ids; ``goal_id``: the plan's goal frontier (None: none);
     ``stamp``: the clock time the plan was made (s); ``dropped``: ids of frontiers the planner
-    found no path to on the map's lethal layer (left out of ``order``).
+    left out of ``order``: no path to them on the map's lethal layer, or beyond its
+    ``max_frontiers``.
     """
 
     frontiers: tuple[Any, ...]
@@ -106,9 +107,9 @@ class FrontierGoal:
     """A goal of frontier following: world (x, y) m, the yaw to face (None: free), its tolerance.
 
     ``kind``: "frontier" (a viewpoint facing the centroid), "push" (beyond a spent frontier's
-    centroid), "squeeze" (the viewpoint of a failed frontier, or of one the planner found no path to, tried again) or "look" (a quarter turn in
-    place); ``frontier``: the frontier id (None for a look); ``through_unknown``: the path may
-    cross floor the map does not know.
+    centroid), "squeeze" (the viewpoint of a failed frontier, or of one the planner found no path
+    to, tried again) or "look" (a quarter turn in place); ``frontier``: the frontier id (None for
+    a look); ``through_unknown``: the path may cross floor the map does not know.
     """
 
     kind: Literal["frontier", "push", "squeeze", "look"]
@@ -231,7 +232,7 @@ def pick_frontier(plan: PlanView | None, visited: Collection[int], pose: Pose2D 
 def pick_squeeze(plan: PlanView | None, ledger: ExploreLedger,
                  s: ExploreSettings) -> tuple[Any, np.ndarray, float | None] | None:
     """(frontier id, viewpoint, yaw) of the first frontier of the plan's order that failed, else of
-    the first the planner found no path to (``plan.dropped``), that was not squeezed yet (its
+    the first the planner left out of its order (``plan.dropped``), that was not squeezed yet (its
     centroid then joins ``ledger.squeezed_frontiers``), or None.
 
     The map's grid can close a passage the robot fits: a goal through unknown floor lets the
@@ -244,7 +245,7 @@ def pick_squeeze(plan: PlanView | None, ledger: ExploreLedger,
         return None
     frontiers = {f.id: f for f in plan.frontiers}
     failed = [fid for fid in plan.order if fid in ledger.failed_frontiers]
-    for fid in failed + [fid for fid in plan.dropped if fid not in failed]:
+    for fid in failed + list(plan.dropped):  # the plan's dropped ids are not in its order
         f = frontiers.get(fid)
         if f is None:
             continue
