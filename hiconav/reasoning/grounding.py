@@ -79,6 +79,9 @@ ROOM_DECAY_M = 2.5  # m: a room cue's weight falls by e over this planar distanc
 ROOM_REACH_M = 6.0  # m: cues farther than this say nothing of an object's room
 # below this posterior the room is unknown (chosen on ProcTHOR train textnav, seeds 0 and 1)
 ROOM_MIN_POSTERIOR = 0.7
+# a described room that is the most probable one at this posterior or more, below
+# ROOM_MIN_POSTERIOR, is "marginal": likelier than every other room together, not sure
+ROOM_LEAN_POSTERIOR = 0.5
 # Aliases people use for the four room types (the parser maps them to these labels or keeps them).
 ROOM_ALIASES: dict[str, str] = {
     "bedroom": "bedroom", "bed_room": "bedroom", "master_bedroom": "bedroom", "guest_room": "bedroom",
@@ -317,7 +320,7 @@ def ground(candidate: BoxLike, objects: Sequence[BoxLike], relations: Sequence[S
     relation that fails only because a related object's box is narrower than its kind is across
     is "unknown" (``could_hold``).
     """
-    rooms = rooms if rooms is not None else infer_rooms(objects, ignore=targets)
+    rooms = rooms if rooms is not None else infer_rooms(objects, ignore=targets, min_posterior=0.0)
     sizes = default_sizes() if sizes is None else sizes
     rels = target_relations(relations, targets)
     if not rels:
@@ -342,6 +345,14 @@ def _one(node: BoxLike, rel: str, obj: str, objects: Sequence[BoxLike], relation
         return "holds", f"a {obj.replace('_', ' ')} is no room type the map infers (not checked)"
     if room is not None and rel.strip().lower() in CONTAINMENT:
         seen, score = rooms.get(node.id, (None, 0.0))
+        if seen is not None and score < ROOM_MIN_POSTERIOR:
+            # ``rooms`` from infer_rooms(min_posterior=0): the most probable room, not sure of it.
+            # The described room leaning ahead of every other together is "marginal": an instance
+            # in a room that shows cues of two (a dining table in a bedroom) would otherwise stay
+            # "unknown" for good, and the robot drove on past it until the step limit
+            if seen == room and score >= ROOM_LEAN_POSTERIOR:
+                return "marginal", f"leans to {seen} (p {score:.2f} < {ROOM_MIN_POSTERIOR:g})"
+            seen = None
         if seen is None:
             return "unknown", ("no room cue seen with it" if score <= 0.0 else
                                f"no room clear enough (p {score:.2f} < {ROOM_MIN_POSTERIOR:g})")

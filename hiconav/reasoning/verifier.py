@@ -278,7 +278,9 @@ class OfflineVerifier:
         # would otherwise confirm the wrong instance beside it
         support = [o for o in objects + context if self._weak(o) is None] if described else []
         # and so must the objects that tell a room (a false "bed" makes a bedroom)
-        rooms = infer_rooms(support, ignore=task.targets, cues=self._room_cues) if described else None
+        # (the most probable room at any posterior: ``ground`` reads it against ROOM_MIN_POSTERIOR)
+        rooms = infer_rooms(support, ignore=task.targets, cues=self._room_cues, min_posterior=0.0) \
+            if described else None
         groundings: dict[int, Any] = {}
         for obj in subgraph.objects:
             score, target = self._match(obj.label, task.targets)

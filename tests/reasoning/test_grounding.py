@@ -352,3 +352,27 @@ def test_a_room_cue_seen_too_weakly_to_count_tells_no_room():
     # a "bed" seen once (a false detection, or a sofa taken for a bed) makes no bedroom yet
     result = verifier.verify(graph([tv, replace(bed, n_obs=1)]), task)
     assert not result.found and result.verdicts == {1: "unknown"}
+
+
+def test_a_described_room_the_cues_lean_to_is_marginal_not_unknown():
+    """A chair in a bedroom that also holds a dining table: its room's posterior stays below
+    ROOM_MIN_POSTERIOR, but the described room leads every other together, so the verdict is
+    "marginal" (offered after the patience), not "unknown" for good; a room that leans the other
+    way stays unknown, and a clear one holds or fails as before."""
+    from hiconav.reasoning.grounding import ROOM_LEAN_POSTERIOR, ROOM_MIN_POSTERIOR
+
+    scene = [node(1, "chair", (0, 0)), node(2, "bed", (1.5, 0), (2.0, 1.6)), node(3, "dining_table", (-1.5, 0))]
+    cues = {"bed": {"bedroom": 2.0}, "dining_table": {"kitchen": 1.0}}  # p(bedroom) = e^2 / (e^2 + e + 2) = 0.61
+    rooms = infer_rooms(scene, ignore=("chair",), cues=cues, min_posterior=0.0)
+    assert rooms[1][0] == "bedroom" and ROOM_LEAN_POSTERIOR <= rooms[1][1] < ROOM_MIN_POSTERIOR
+    in_bedroom = decompose_instruction("go to the chair in the bedroom", ReasoningConfig(), similarity=None)
+    in_kitchen = decompose_instruction("go to the chair in the kitchen", ReasoningConfig(), similarity=None)
+    verdict = ground(scene[0], scene, in_bedroom.relations, in_bedroom.targets, rooms)
+    assert verdict.status == "marginal", verdict.evidence
+    assert ground(scene[0], scene, in_kitchen.relations, in_kitchen.targets, rooms).status == "unknown"
+    # the thresholded map (infer_rooms' default) knows no room here: unknown, as before
+    sure_only = infer_rooms(scene, ignore=("chair",), cues=cues)
+    assert ground(scene[0], scene, in_bedroom.relations, in_bedroom.targets, sure_only).status == "unknown"
+    clear = infer_rooms(scene[:2], ignore=("chair",), cues={"bed": {"bedroom": 3.0}}, min_posterior=0.0)
+    assert ground(scene[0], scene[:2], in_bedroom.relations, in_bedroom.targets, clear).status == "holds"
+    assert ground(scene[0], scene[:2], in_kitchen.relations, in_kitchen.targets, clear).status == "fails"
