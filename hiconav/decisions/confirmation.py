@@ -214,6 +214,18 @@ def label_verdict(task_targets: Iterable[str] | None, label: str, source: str) -
     return None
 
 
+def withdrawn(source: str, object_id: int, ruled_out: Iterable[int]) -> bool:
+    """True when a candidate the reasoning layer offered (``source`` "hypothesis") is among the
+    nodes its latest verdicts rule out (``ruled_out``: a relation of the description fails on it).
+
+    An instance offered undecided (a relation within the boxes' noise margin, a room the cues
+    only lean to) goes on being judged while the robot drives to it, on the nodes mapped since; a
+    later verdict that fails withdraws the offer, and the robot that stopped at it anyway stopped
+    at an instance the description rules out. A verdict that holds or is unknown again puts it
+    back (``ruled_out`` is the latest set)."""
+    return source == "hypothesis" and int(object_id) in set(ruled_out)
+
+
 def timeout_verdict(settings: VerifySettings, elapsed: float) -> Verdict | None:
     """Deferred when ``elapsed`` clock seconds have passed since the verification started
     without a verdict (``timeout_s``); else None."""

@@ -193,3 +193,11 @@ def test_two_boxes_are_one_object_when_either_footprint_holds_the_others_centre(
     assert conf.same_object(lo, hi, np.array([0.4, 0.4, 0.0]), np.array([0.6, 0.6, 0.5]))  # a sliver inside
     assert not conf.same_object(lo, hi, lo + [1.05, 0.0, 0.0], hi + [1.05, 0.0, 0.0])  # side by side
     assert not conf.same_object(lo, hi, lo + 0.8, hi + 0.8)  # corners overlapping
+
+
+def test_an_offer_the_reasoning_layer_since_ruled_out_is_withdrawn():
+    from hiconav.decisions.confirmation import withdrawn
+
+    assert withdrawn("hypothesis", 14, frozenset({14, 3}))
+    assert not withdrawn("hypothesis", 14, frozenset({3}))  # a verdict that holds again puts it back
+    assert not withdrawn("memory-label", 14, frozenset({14}))  # only the reasoning layer's own offers

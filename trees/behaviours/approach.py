@@ -45,8 +45,7 @@ class Approach(_GoToObject):
     def update(self) -> Status:
         ctx, s = self.context, self.settings
         cand: Candidate | None = self.read("target")
-        if cand is None:
-            self.feedback_message = "no target"
+        if self._lost(cand):
             return Status.FAILURE
         pose = ctx.pose
         if pose is not None and not (self._crept and not self._turned) and plan.done(

@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from hiconav.decisions.confirmation import withdrawn
 from hiconav.decisions.cells import camera_of, cell_near, furniture_boxes, wall_heights
 from hiconav.decisions.progress import StallClock
 from hiconav.decisions.geometry import facing as _facing
@@ -28,6 +29,21 @@ class _GoToObject(MissionBehaviour):
         self._stall = StallClock()
 
     READS = ("target",)
+
+    def _lost(self, cand: Candidate | None) -> bool:
+        """True (the behaviour fails) when there is no target, or when the reasoning layer has since
+        ruled ``cand`` out (``hiconav.decisions.confirmation.withdrawn``; its goal is cancelled,
+        and the candidate list no longer offers it)."""
+        ctx = self.context
+        if cand is None:
+            self.feedback_message = "no target"
+            return True
+        if not withdrawn(cand.source, cand.object_id, ctx.ruled_out):
+            return False
+        ctx.send_goal(None)
+        self.feedback_message = f"{cand.label} #{cand.object_id}: ruled out by the reasoning layer"
+        return True
+
     def _centre_weight(self) -> float:
         """approach_cell's weight on a cell's distance to the footprint's centre (see Approach)."""
         return 0.0

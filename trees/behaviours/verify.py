@@ -110,8 +110,8 @@ class VerifyTarget(_GoToObject):
                 ("verification disabled: candidate accepted as is", Status.SUCCESS) if not ctx.verify else
                 (f"last resort: {cand.label} #{cand.object_id} taken as it is", Status.SUCCESS))
             return status
-        if (obj := ctx.object(cand.object_id)) is None:
-            return self._reject(conf.Verdict("rejected", "object node disappeared from memory"))
+        if (obj := ctx.object(cand.object_id)) is None or self._lost(cand):
+            return self._reject(conf.Verdict("rejected", "object node disappeared from memory")) if obj is None else Status.FAILURE
         if (switched := self._switch(obj, cand)) is not None:
             return switched
         current = Candidate(cand.object_id, *verif.node_fields(obj), cand.source)
