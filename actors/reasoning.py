@@ -24,7 +24,7 @@ from hiconav.actors.runtime import NodeActor
 
 from hiconav.messages import (ExploredOut, HypothesisMsg, ParseRequest, ReasoningBusy, RuledOut, TargetRejected,
                               TaskMsg, WorldSnapshot)
-from hiconav.reasoning.unresolved import due_marginal, track_marginal, unresolved_hypothesis
+from hiconav.reasoning.unresolved import due_marginal, track_marginal, unresolved_hypothesis, withdrawn_offers
 
 
 class ReasoningActor(NodeActor):
@@ -70,6 +70,9 @@ class ReasoningNode(Node):
         # the search explored out: offer the best unresolved candidate (once per ExploredOut)
         self._explored_out = False
         self._offered: set[int] = set()
+        # object id -> its verdict when offered, and the offers withdrawn since (``withdrawn_offers``)
+        self._offer_verdicts: dict[int, str | None] = {}
+        self._withdrawn: set[int] = set()
         self._memory: Any = None  # the last memory snapshot seen
         self.latest_wins(WorldSnapshot)
         self.on(ParseRequest, lambda m, now: setattr(self, "_parse", m))
@@ -86,6 +89,7 @@ class ReasoningNode(Node):
         self._ruled_out = frozenset()  # exploration forgets its set on the new TaskMsg too
         self._explored_out = False
         self._offered = set()
+        self._offer_verdicts, self._withdrawn = {}, set()
         self._marginal_since = {}
         self.reasoner = self.make_reasoner(task) if self.make_reasoner is not None else None
 
@@ -121,10 +125,12 @@ class ReasoningNode(Node):
     def _post_ruled_out(self, result: Any, now: float, delay: float) -> None:
         """Record the result's verdicts (and since when each marginal one has been marginal), and
         tell exploration which target-category nodes the relations rule out, when that set
-        changes (a later verdict that holds or is unknown takes a node back)."""
+        changes (a later verdict that holds or is unknown takes a node back, but not an offer
+        withdrawn: ``withdrawn_offers``)."""
         self.verdicts.update(getattr(result, "verdicts", None) or {})
         self._marginal_since = track_marginal(self._marginal_since, self.verdicts, now)
-        ruled_out = frozenset(i for i, v in self.verdicts.items() if v == "fails")
+        self._withdrawn |= withdrawn_offers(self._offer_verdicts, self.verdicts)
+        ruled_out = frozenset(i for i, v in self.verdicts.items() if v == "fails") | self._withdrawn
         if ruled_out != self._ruled_out:
             self._ruled_out = ruled_out
             self.emit(("exploration", "mission"), RuledOut(ruled_out, now + delay), delay)
@@ -191,6 +197,7 @@ class ReasoningNode(Node):
                 self._offered.update(verdicts)
             return False
         self._offered.add(int(hyp.object_id))
+        self._offer_verdicts[int(hyp.object_id)] = self.verdicts.get(int(hyp.object_id))
         self.requests += 1
         delay = self._delay(self.latency_s, 0.0)
         self._busy(now, delay)

@@ -29,7 +29,8 @@ from hiconav.reasoning.grounding import labels_match
 from hiconav.reasoning.hypothesis import TargetHypothesis
 from hiconav.reasoning.verifier import best_view
 
-__all__ = ["VERDICT_RANK", "best_unresolved", "due_marginal", "track_marginal", "unresolved_hypothesis"]
+__all__ = ["VERDICT_RANK", "best_unresolved", "due_marginal", "track_marginal", "unresolved_hypothesis",
+           "withdrawn_offers"]
 
 # a verdict's place in the order (lower first); verdicts not listed are never offered
 VERDICT_RANK: dict[str, int] = {"holds": 0, "marginal": 1, "unknown": 2, "fails": 3}
@@ -68,6 +69,18 @@ def due_marginal(since: Mapping[int, float], now: float, patience_s: float,
     if patience_s <= 0.0:
         return {}
     return {oid: "marginal" for oid, t0 in since.items() if now - t0 >= patience_s and oid not in exclude}
+
+
+def withdrawn_offers(offered: Mapping[int, str | None], verdicts: Mapping[int, str]) -> set[int]:
+    """The offered nodes (``offered``: object id -> its verdict when it was offered) whose verdict
+    has turned to "fails" since: the offer is withdrawn for good.
+
+    An undecided instance is offered (marginal patience, explored out) and judged on while the
+    robot drives to it. Its room posterior sways with the nodes each subgraph holds: one call
+    reads "fails" (another room at p 0.76) and the next "marginal" again from fewer cues, and the
+    robot that resumed on the sway stopped at an instance the description rules out. A node
+    offered as it failed (the last resort of an explored-out search) is not withdrawn."""
+    return {oid for oid, then in offered.items() if then != "fails" and verdicts.get(oid) == "fails"}
 
 
 def unresolved_hypothesis(memory: Any, verdicts: Mapping[int, str], targets: Sequence[str],

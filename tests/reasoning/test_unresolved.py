@@ -75,3 +75,11 @@ def test_a_marginal_candidate_is_due_once_its_patience_ran_out_and_not_offered_b
     nodes = [_node(1, "tv", 0.5, 4), _node(2, "tv", 0.9, 9), _node(3, "tv", 0.9, 30)]
     # offered among the due ones alone, by evidence: never a node that is not marginal
     assert best_unresolved(nodes, due_marginal(since, now=20.0, patience_s=10.0), ["tv"]).id == 2
+
+
+def test_an_offer_whose_verdict_turns_to_fails_is_withdrawn_for_good():
+    from hiconav.reasoning.unresolved import withdrawn_offers
+
+    offered = {14: "marginal", 20: "fails", 31: None}
+    assert withdrawn_offers(offered, {14: "fails", 20: "fails", 31: "fails"}) == {14, 31}
+    assert withdrawn_offers(offered, {14: "marginal", 20: "fails"}) == set()  # the last resort stays
