@@ -80,8 +80,12 @@ class MissionNode(Node):
         self.on(HypothesisMsg, lambda m, now: self.context.hypotheses.append(m.hypothesis))
         self.on(NavStatus, self._on_nav)
         self.on(HealthAlert, lambda m, now: self.context.alerts.append(m))
-        self.on(RuledOut, lambda m, now: setattr(self.context, "ruled_out", frozenset(m.object_ids)))
+        self.on(RuledOut, self._on_ruled_out)
         self.on(EpisodeEnded, lambda m, now: setattr(self, "episode", m))
+
+    def _on_ruled_out(self, msg: RuledOut, now: float) -> None:
+        self.context.ruled_out = frozenset(msg.object_ids)
+        self.context.withdrawn = frozenset(msg.withdrawn)
 
     def _on_nav(self, msg: NavStatus, now: float) -> None:
         if msg.goal_seq == self.context.goal_seq:

@@ -70,7 +70,8 @@ class ReasoningNode(Node):
         # the search explored out: offer the best unresolved candidate (once per ExploredOut)
         self._explored_out = False
         self._offered: set[int] = set()
-        # object id -> its verdict when offered, and the offers withdrawn since (``withdrawn_offers``)
+        # object id -> its verdict when offered for want of a clearer instance (marginal patience),
+        # and the offers withdrawn since (``withdrawn_offers``)
         self._offer_verdicts: dict[int, str | None] = {}
         self._withdrawn: set[int] = set()
         self._memory: Any = None  # the last memory snapshot seen
@@ -125,15 +126,15 @@ class ReasoningNode(Node):
     def _post_ruled_out(self, result: Any, now: float, delay: float) -> None:
         """Record the result's verdicts (and since when each marginal one has been marginal), and
         tell exploration which target-category nodes the relations rule out, when that set
-        changes (a later verdict that holds or is unknown takes a node back, but not an offer
-        withdrawn: ``withdrawn_offers``)."""
+        changes (a later verdict that holds or is unknown takes a node back), with the offers
+        withdrawn for good (``withdrawn_offers``)."""
         self.verdicts.update(getattr(result, "verdicts", None) or {})
         self._marginal_since = track_marginal(self._marginal_since, self.verdicts, now)
-        self._withdrawn |= withdrawn_offers(self._offer_verdicts, self.verdicts)
-        ruled_out = frozenset(i for i, v in self.verdicts.items() if v == "fails") | self._withdrawn
-        if ruled_out != self._ruled_out:
-            self._ruled_out = ruled_out
-            self.emit(("exploration", "mission"), RuledOut(ruled_out, now + delay), delay)
+        withdrawn = self._withdrawn | withdrawn_offers(self._offer_verdicts, self.verdicts)
+        ruled_out = frozenset(i for i, v in self.verdicts.items() if v == "fails")
+        if ruled_out != self._ruled_out or withdrawn != self._withdrawn:
+            self._ruled_out, self._withdrawn = ruled_out, withdrawn
+            self.emit(("exploration", "mission"), RuledOut(ruled_out, now + delay, frozenset(withdrawn)), delay)
 
     def tick(self, now: float) -> None:
         if now < self.busy_until - 1e-9:
@@ -197,7 +198,8 @@ class ReasoningNode(Node):
                 self._offered.update(verdicts)
             return False
         self._offered.add(int(hyp.object_id))
-        self._offer_verdicts[int(hyp.object_id)] = self.verdicts.get(int(hyp.object_id))
+        if verdicts is not None:  # an explored-out offer is the last resort: never withdrawn
+            self._offer_verdicts[int(hyp.object_id)] = self.verdicts.get(int(hyp.object_id))
         self.requests += 1
         delay = self._delay(self.latency_s, 0.0)
         self._busy(now, delay)

@@ -93,10 +93,13 @@ class PlanMsg:
 class RuledOut:
     """Reasoning -> Exploration: the object nodes of the target's category that the reasoning
     layer judged not to be the described instance (a relation of the instruction fails on them),
-    the whole current set (latest wins); exploration stops treating them as target evidence."""
+    the whole current set (latest wins); exploration stops treating them as target evidence.
+    ``withdrawn``: the offers (hypotheses) the reasoning layer has taken back for good
+    (``hiconav.reasoning.unresolved.withdrawn_offers``); the mission stops pursuing them."""
 
     object_ids: frozenset[int]
     stamp: float = 0.0
+    withdrawn: frozenset[int] = frozenset()
 
 
 @dataclass(frozen=True)

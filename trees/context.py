@@ -133,6 +133,8 @@ class MissionContext:
     # the target-category nodes the reasoning layer rules out (RuledOut, latest wins) and those
     # Explore has lingered by (``decisions.linger``)
     ruled_out: frozenset[int] = frozenset()
+    # the offers the reasoning layer took back for good (RuledOut.withdrawn): no longer candidates
+    withdrawn: frozenset[int] = frozenset()
     lingered: set[int] = field(default_factory=set)
 
     # -- time and pose -------------------------------------------------------------------------
@@ -289,7 +291,7 @@ class MissionContext:
             out.append(self.candidate_of(node, resort.SOURCE, float(node.confidence)))
         for hyp in reversed(self.hypotheses):
             oid = self._resolve(hyp, memory, objects)
-            if oid is None or oid in seen or self.excluded(oid) or conf.withdrawn(HYPOTHESIS, oid, self.ruled_out):
+            if oid is None or oid in seen or self.excluded(oid) or conf.withdrawn(HYPOTHESIS, oid, self.withdrawn):
                 continue
             seen.add(oid)
             out.append(self.candidate_of(objects[oid], HYPOTHESIS, float(getattr(hyp, "confidence", 0.0))))

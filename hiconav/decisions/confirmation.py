@@ -214,16 +214,15 @@ def label_verdict(task_targets: Iterable[str] | None, label: str, source: str) -
     return None
 
 
-def withdrawn(source: str, object_id: int, ruled_out: Iterable[int]) -> bool:
+def withdrawn(source: str, object_id: int, taken_back: Iterable[int]) -> bool:
     """True when a candidate the reasoning layer offered (``source`` "hypothesis") is among the
-    nodes its latest verdicts rule out (``ruled_out``: a relation of the description fails on it).
+    offers it has since taken back (``taken_back``: ``RuledOut.withdrawn``).
 
-    An instance offered undecided (a relation within the boxes' noise margin, a room the cues
-    only lean to) goes on being judged while the robot drives to it, on the nodes mapped since; a
-    later verdict that fails withdraws the offer, and the robot that stopped at it anyway stopped
-    at an instance the description rules out. A verdict that holds or is unknown again puts it
-    back (``ruled_out`` is the latest set)."""
-    return source == "hypothesis" and int(object_id) in set(ruled_out)
+    An instance offered undecided, for want of a clearer one after the marginal patience, goes
+    on being judged while the robot drives to it, on the nodes mapped since; when a verdict on
+    it fails, the robot that stopped at it anyway stopped at an instance the description rules
+    out (``hiconav.reasoning.unresolved.withdrawn_offers`` decides which offers are taken back)."""
+    return source == "hypothesis" and int(object_id) in set(taken_back)
 
 
 def timeout_verdict(settings: VerifySettings, elapsed: float) -> Verdict | None:

@@ -75,11 +75,12 @@ def withdrawn_offers(offered: Mapping[int, str | None], verdicts: Mapping[int, s
     """The offered nodes (``offered``: object id -> its verdict when it was offered) whose verdict
     has turned to "fails" since: the offer is withdrawn for good.
 
-    An undecided instance is offered (marginal patience, explored out) and judged on while the
-    robot drives to it. Its room posterior sways with the nodes each subgraph holds: one call
-    reads "fails" (another room at p 0.76) and the next "marginal" again from fewer cues, and the
-    robot that resumed on the sway stopped at an instance the description rules out. A node
-    offered as it failed (the last resort of an explored-out search) is not withdrawn."""
+    An undecided instance offered after the marginal patience is judged on while the robot
+    drives to it. Its room posterior sways with the nodes each subgraph holds: one call reads
+    "fails" (another room at p 0.76) and the next "marginal" again from fewer cues, and the robot
+    stopped at an instance the description rules out. The caller records only such offers: an
+    explored-out offer is the mission's last resort, kept whatever the verdicts say, and a node
+    offered as it failed is never withdrawn."""
     return {oid for oid, then in offered.items() if then != "fails" and verdicts.get(oid) == "fails"}
 
 

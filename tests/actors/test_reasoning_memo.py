@@ -159,3 +159,31 @@ def test_a_marginal_candidate_is_offered_once_its_patience_runs_out():
     for k in range(1, 25):
         _tick(quiet, memory, round(0.1 * k, 1))
     assert not [o for o in quiet.drain() if isinstance(o.msg, HypothesisMsg)]
+
+
+def test_a_marginal_offer_that_fails_later_is_withdrawn_for_good_an_explored_out_one_is_not():
+    from hiconav.messages import ExploredOut, RuledOut
+
+    def withdrawn(node, t) -> frozenset | None:
+        _tick(node, memory, t)
+        posted = [o.msg.withdrawn for o in node.drain() if isinstance(o.msg, RuledOut) and o.dest == "mission"]
+        return posted[-1] if posted else None
+
+    verdicts, relation = {4: "marginal", 5: "unknown"}, ("tv", "next to", "sofa")
+    node, memory = _two_tvs(verdicts, relation, marginal_patience_s=1.0)
+    for k in range(1, 13):  # offered at 1.1 s
+        _tick(node, memory, round(0.1 * k, 1))
+    node.drain()
+    verdicts[4] = "fails"  # judged on the nodes mapped since: another room
+    assert withdrawn(node, 1.3) == frozenset({4})
+    verdicts[4] = "marginal"  # the next subgraph holds fewer cues: the posterior sways back
+    assert withdrawn(node, 1.4) == frozenset({4})  # taken back for good (the set changed: posted)
+    # an explored-out offer is the last resort: a verdict that fails after it takes nothing back
+    verdicts2 = {4: "unknown", 5: "fails"}
+    last, memory = _two_tvs(verdicts2, ("tv", "in", "bedroom"))
+    _tick(last, memory, 0.1)
+    last.receive(ExploredOut(0.2), 0.2)
+    _tick(last, memory, 0.2)
+    last.drain()
+    verdicts2[4] = "fails"
+    assert withdrawn(last, 0.3) == frozenset()

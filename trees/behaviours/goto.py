@@ -31,17 +31,17 @@ class _GoToObject(MissionBehaviour):
     READS = ("target",)
 
     def _lost(self, cand: Candidate | None) -> bool:
-        """True (the behaviour fails) when there is no target, or when the reasoning layer has since
-        ruled ``cand`` out (``hiconav.decisions.confirmation.withdrawn``; its goal is cancelled,
+        """True (the behaviour fails) when there is no target, or when the reasoning layer has
+        withdrawn ``cand`` (``hiconav.decisions.confirmation.withdrawn``; its goal is cancelled,
         and the candidate list no longer offers it)."""
         ctx = self.context
         if cand is None:
             self.feedback_message = "no target"
             return True
-        if not withdrawn(cand.source, cand.object_id, ctx.ruled_out):
+        if not withdrawn(cand.source, cand.object_id, ctx.withdrawn):
             return False
         ctx.send_goal(None)
-        self.feedback_message = f"{cand.label} #{cand.object_id}: ruled out by the reasoning layer"
+        self.feedback_message = f"{cand.label} #{cand.object_id}: withdrawn by the reasoning layer"
         return True
 
     def _centre_weight(self) -> float:
