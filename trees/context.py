@@ -20,7 +20,6 @@ from typing import Any
 
 import numpy as np
 
-from hiconav.decisions import confirmation as conf
 from hiconav.decisions import last_resort as resort
 from hiconav.decisions.config import DecisionsConfig
 from hiconav.decisions.verification import HYPOTHESIS
@@ -291,7 +290,7 @@ class MissionContext:
             out.append(self.candidate_of(node, resort.SOURCE, float(node.confidence)))
         for hyp in reversed(self.hypotheses):
             oid = self._resolve(hyp, memory, objects)
-            if oid is None or oid in seen or self.excluded(oid) or conf.withdrawn(HYPOTHESIS, oid, self.withdrawn):
+            if oid is None or oid in seen or self.excluded(oid) or oid in self.withdrawn:
                 continue
             seen.add(oid)
             out.append(self.candidate_of(objects[oid], HYPOTHESIS, float(getattr(hyp, "confidence", 0.0))))

@@ -77,7 +77,7 @@ def withdrawn_offers(offered: Mapping[int, str | None], verdicts: Mapping[int, s
 
     An undecided instance offered after the marginal patience is judged on while the robot
     drives to it. Its room posterior sways with the nodes each subgraph holds: one call reads
-    "fails" (another room at p 0.76) and the next "marginal" again from fewer cues, and the robot
+    "fails" (another room, surely) and the next "marginal" again from fewer cues, and the robot
     stopped at an instance the description rules out. The caller records only such offers: an
     explored-out offer is the mission's last resort, kept whatever the verdicts say, and a node
     offered as it failed is never withdrawn."""

@@ -30,13 +30,13 @@ class _GoToObject(MissionBehaviour):
 
     READS = ("target",)
 
-    def _lost(self, cand: Candidate | None) -> bool:
-        """True (the behaviour fails) when there is no target, or when the reasoning layer has
-        withdrawn ``cand`` (``hiconav.decisions.confirmation.withdrawn``; its goal is cancelled,
-        and the candidate list no longer offers it)."""
+    def _lost(self, cand: Candidate | None, no_target: str = "no target") -> bool:
+        """True (the behaviour fails; feedback ``no_target``) when there is no target, or when the
+        reasoning layer has withdrawn ``cand`` (``hiconav.decisions.confirmation.withdrawn``; its
+        goal is cancelled, and the candidate list no longer offers it)."""
         ctx = self.context
         if cand is None:
-            self.feedback_message = "no target"
+            self.feedback_message = no_target
             return True
         if not withdrawn(cand.source, cand.object_id, ctx.withdrawn):
             return False

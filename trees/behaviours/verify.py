@@ -104,14 +104,14 @@ class VerifyTarget(_GoToObject):
 
     def update(self) -> Status:
         ctx, cand = self.context, self._cand
-        if cand is None or not ctx.verify or cand.source == resort.SOURCE:  # a last resort had no view point
-            self.feedback_message, status = (
-                ("no target to verify", Status.FAILURE) if cand is None else
-                ("verification disabled: candidate accepted as is", Status.SUCCESS) if not ctx.verify else
-                (f"last resort: {cand.label} #{cand.object_id} taken as it is", Status.SUCCESS))
-            return status
-        if (obj := ctx.object(cand.object_id)) is None or self._lost(cand):
-            return self._reject(conf.Verdict("rejected", "object node disappeared from memory")) if obj is None else Status.FAILURE
+        if self._lost(cand, "no target to verify"):
+            return Status.FAILURE
+        if not ctx.verify or cand.source == resort.SOURCE:  # a last resort had no view point
+            self.feedback_message = ("verification disabled: candidate accepted as is" if not ctx.verify else
+                                     f"last resort: {cand.label} #{cand.object_id} taken as it is")
+            return Status.SUCCESS
+        if (obj := ctx.object(cand.object_id)) is None:
+            return self._reject(conf.Verdict("rejected", "object node disappeared from memory"))
         if (switched := self._switch(obj, cand)) is not None:
             return switched
         current = Candidate(cand.object_id, *verif.node_fields(obj), cand.source)
