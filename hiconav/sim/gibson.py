@@ -209,12 +209,58 @@ def render_obstacles(nav_mask: np.ndarray, objects: np.ndarray, radius: float = 
     edge runs through its edge cells), so that a map of what the robot sees, inflated by the
     robot's radius, leaves the navmesh free. A band of non-navigable cells too thin to hold such a cell (a
     thin inner wall, a doorway's jamb) keeps its ridge cells (those no nearer the navmesh than any
-    neighbour), so that no wall between two rooms disappears from view.
+    neighbour), so that no wall between two rooms disappears from view, and a gap the navmesh does
+    not pass through is drawn across (``closed_necks``), so that it does not look open either.
     """
-    blocked = ~nav_mask & ~objects
+    return ~nav_mask & ~objects & beyond_radius(nav_mask, radius, res)
+
+
+def beyond_radius(nav_mask: np.ndarray, radius: float = HABITAT_AGENT_RADIUS,
+                  res: float = RESOLUTION) -> np.ndarray:
+    """(H, W) bool cells whose centre lies farther than ``radius`` plus half a cell from the
+    nearest navmesh cell's centre, or on a ridge (no nearer the navmesh than any neighbour):
+    where an obstacle stands in the world of a navmesh that keeps the agent's centre ``radius``
+    from it (``render_obstacles`` draws walls there, ``load_gibson_file`` labelled objects)."""
     dist = ndimage.distance_transform_edt(~nav_mask) * res
     ridge = dist >= ndimage.maximum_filter(dist, size=3) - 1e-9
-    return blocked & ((dist > radius + res / 2.0 + 1e-9) | ridge)
+    return (dist > radius + res / 2.0 + 1e-9) | ridge | closed_necks(nav_mask, dist, radius, res)
+
+
+def closed_necks(nav_mask: np.ndarray, dist: np.ndarray, radius: float = HABITAT_AGENT_RADIUS,
+                 res: float = RESOLUTION) -> np.ndarray:
+    """(H, W) bool non-navigable cells within ``radius`` of the navmesh that separate it: the
+    navmesh cells within ``radius`` plus a cell of them fall apart into two or more pieces of a
+    disc radius's cells or more there (a smaller piece is a jag of the navmesh's outline).
+
+    The navmesh stops short of a gap too narrow for the agent (between a pillar and a wall, two
+    table legs, a door ajar), and nothing in the maps stands in the gap: the cells there are
+    nearer the navmesh than any obstacle would stand, so without this the gap looks open to the
+    robot while the agent cannot pass it. At a plain wall or corner the navmesh within the disc
+    is one piece; across a closed gap it is two.
+    """
+    r = int(math.ceil((radius + res) / res))
+    # only the gap's middle line is drawn: cells no nearer the navmesh than their two neighbours
+    # along some axis and farther than one of them (a saddle's crest; a band's edge cells are not)
+    pad_d = np.pad(dist, 1, mode="edge")
+    h, w = dist.shape
+    crest = np.zeros_like(nav_mask, dtype=bool)
+    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
+        a = pad_d[1 + dr:1 + dr + h, 1 + dc:1 + dc + w]
+        b = pad_d[1 - dr:1 - dr + h, 1 - dc:1 - dc + w]
+        crest |= (dist >= a - 1e-9) & (dist >= b - 1e-9) & ((dist > a + 1e-9) | (dist > b + 1e-9))
+    band = ~nav_mask & (dist <= radius + res / 2.0 + 1e-9) & crest
+    out = np.zeros_like(nav_mask, dtype=bool)
+    rows, cols = np.nonzero(band)
+    if len(rows) == 0:
+        return out
+    yy, xx = np.mgrid[-r:r + 1, -r:r + 1]
+    disc = yy ** 2 + xx ** 2 <= r * r
+    pad = np.pad(nav_mask, r, constant_values=False)
+    for i, j in zip(rows.tolist(), cols.tolist()):
+        labels, n = ndimage.label(pad[i:i + 2 * r + 1, j:j + 2 * r + 1] & disc, structure=EIGHT)
+        if n >= 2 and int(np.sum(np.bincount(labels.ravel())[1:] >= r)) >= 2:
+            out[i, j] = True
+    return out
 
 
 def load_gibson(scene: str, floor: int, data_dir: Path) -> House:
@@ -236,6 +282,13 @@ def load_gibson_file(path: Path | str, scene: str, floor: int, *, name: str | No
     quads: list[QuadSet] = []
     footprints: dict[int, np.ndarray] = {}
     any_object = np.zeros_like(nav_mask)
+    nav_mask = clean_floor(nav_mask, sem[1:16].any(axis=0))
+    # where an obstacle may stand (``beyond_radius``): the walls and clutter, and the labelled
+    # objects, whose cells reach right up to the navmesh where the scan's projection of an object
+    # is wider than what blocks the agent (about a tenth of the object cells of the 25 floors; drawn
+    # whole, they closed corridors the agent passes); an object's every cell still scores success
+    solid = beyond_radius(nav_mask)
+    drawn_objects = np.zeros_like(nav_mask)
     for k, cat in enumerate(CHANNEL_CATEGORIES, start=1):
         labels, n = ndimage.label(sem[k], structure=EIGHT)
         if n == 0:
@@ -262,14 +315,16 @@ def load_gibson_file(path: Path | str, scene: str, floor: int, *, name: str | No
             win_origin = np.array([x0, y0])
             shade = 0.85 + 0.3 * ((iid * 0.6180339) % 1.0)
             color = tuple(np.clip(np.array(category_color(cat)) * shade, 0, 1))
-            quads.append(mask_side_quads(window, win_origin, RESOLUTION, z0, z1, color, iid,
+            drawn = window & solid[sl]
+            drawn = drawn if drawn.any() else window  # never hidden whole
+            drawn_objects[sl] |= drawn
+            quads.append(mask_side_quads(drawn, win_origin, RESOLUTION, z0, z1, color, iid,
                                          "object", top=True))
     # Walls / clutter: every other cell, drawn as the vertical faces that border the floor
     # or an object (the only faces visible from the floor; the ceiling covers their tops), one
     # agent radius beyond the navmesh's edge (``render_obstacles``).
-    nav_mask = clean_floor(nav_mask, any_object)
     walls, furniture = split_clutter(~(nav_mask | any_object))
-    drawn = render_obstacles(nav_mask, any_object)
+    drawn = ~nav_mask & ~any_object & solid  # ``render_obstacles``
     walls &= drawn
     furniture &= drawn
     quads.append(mask_side_quads(walls, origin, RESOLUTION, 0.0, WALL_HEIGHT,
@@ -278,7 +333,7 @@ def load_gibson_file(path: Path | str, scene: str, floor: int, *, name: str | No
                                  (0.55, 0.45, 0.35), material="wall", top=True))
     # The navigable grid is the floor free of drawn obstacles and objects; the robot's centre
     # may stand on the navmesh alone (``House.centre_free``), as in Habitat.
-    nav = NavGrid(~(walls | furniture | any_object), origin, RESOLUTION)
+    nav = NavGrid(~(walls | furniture | drawn_objects), origin, RESOLUTION)
     centre = nav_mask.copy()
     centre.flags.writeable = False
     return House(name=name or f"{path.resolve()}#{scene}/{floor}", objects=objects, nav=nav, rooms=[],
