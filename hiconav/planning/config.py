@@ -70,7 +70,13 @@ class NavigatorConfig(BaseModel):
     settle_m: float = Field(0.3, ge=0.0, description="see settle_steps")
     replan_every: int = Field(10, ge=1, description="re-plan at least every n steps")
     deviation_m: float = Field(0.5, gt=0.0, description="re-plan when this far from the path")
-    stuck_progress_m: float = Field(0.05, ge=0.0, description="a forward step moving less than this is stuck")
+    stuck_progress_m: float = Field(0.05, ge=0.0, description="velocity mode: moving less than twice this in "
+                                                              "stuck_time_s is stuck")
+    forward_blocked_m: float = Field(
+        0.1, ge=0.0, description="discrete mode: a forward step that moved the robot (or brought a straight goal "
+                                 "nearer) by less than this was blocked; a blocked step slides along the obstacle "
+                                 "a few centimetres"
+    )
     stuck_limit: int = Field(2, ge=1, description="stuck steps in a row before a recovery")
     virtual_obstacle_m: float = Field(
         0.15, ge=0.0, description="radius of the obstacle placed where the robot got stuck"

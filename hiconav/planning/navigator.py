@@ -437,14 +437,17 @@ class Navigator:
 
     def _forward_blocked(self, pose: Pose2D) -> bool:
         """True when the last action was a forward step that moved the robot less than
-        ``stuck_progress_m`` (to ``pose``): something the map may not know is in the way."""
+        ``forward_blocked_m`` (to ``pose``): something the map may not know is in the way. A blocked
+        step slides along the obstacle (Habitat-Sim's default): the robot moves a few centimetres
+        sideways, and a slide counted as a step taken turned it back and forth at a gap its map
+        showed open, sliding to and fro, for the rest of the episode."""
         return self._last_action == DiscreteAction.MOVE_FORWARD and self._last_pose is not None \
-            and self._last_pose.distance_to(pose) < self.config.stuck_progress_m
+            and self._last_pose.distance_to(pose) < self.config.forward_blocked_m
 
     def _step_straight(self, grid: GridLike, pose: Pose2D) -> DiscreteAction:
         """A ``Goal.straight`` step: face the goal and step forward, no plan; done (facing the
         goal's yaw) within its tolerance, within half a step of it, when a forward step was blocked
-        (moved the robot, or brought it nearer the goal, by less than ``stuck_progress_m``) or the
+        (moved the robot, or brought it nearer the goal, by less than ``forward_blocked_m``) or the
         point half a step ahead is a cell the map knows occupied.
 
         The planner keeps the robot centre a robot radius from every occupied cell, and the cells'
@@ -460,7 +463,7 @@ class Navigator:
         # the other as its heading to the goal swings, and drives on without coming nearer
         blocked = self._forward_blocked(pose) or (
             self._last_action == DiscreteAction.MOVE_FORWARD and self._straight_from is not None
-            and self._straight_from - d < cfg.stuck_progress_m)
+            and self._straight_from - d < cfg.forward_blocked_m)
         self._straight_from = None
         heading = math.atan2(goal.y - pose.y, goal.x - pose.x)
         done = self.reached or blocked or d <= max(goal.tolerance, 0.5 * step)

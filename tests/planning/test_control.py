@@ -167,6 +167,23 @@ def test_recovers_when_stuck_on_an_unmapped_obstacle():
     assert np.hypot(pose.x - 4.0, pose.y - 2.5) <= 0.25
 
 
+def test_a_forward_step_that_slid_along_an_obstacle_counts_as_blocked():
+    # a blocked step slides along the obstacle (Habitat-Sim's default, and the simulator's): the
+    # robot moves a few centimetres sideways, not the step's 0.25 m; counted as a step taken, it
+    # turned back and forth at a gap its map showed open, sliding to and fro, until the step limit
+    grid = snapshot(open_room())
+    nav = Navigator()
+    nav.set_goal(Goal(4.0, 2.5, tolerance=0.25))
+    assert nav.step(grid, Pose2D(1.0, 2.5, 0.0)) == DiscreteAction.MOVE_FORWARD
+    nav.step(grid, Pose2D(1.0, 2.57, 0.0))  # 7 cm along the obstacle
+    assert len(nav._virtual) == 1
+    nav2 = Navigator()
+    nav2.set_goal(Goal(4.0, 2.5, tolerance=0.25))
+    nav2.step(grid, Pose2D(1.0, 2.5, 0.0))
+    nav2.step(grid, Pose2D(1.19, 2.5, 0.0))  # most of a step, slowed by the slide's last sub-step
+    assert not nav2._virtual
+
+
 def test_velocity_mode_backs_off_when_stuck():
     grid = snapshot(open_room())
     nav = Navigator()
