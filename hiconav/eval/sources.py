@@ -479,6 +479,7 @@ def _habitat_group(path: Path, raw: list[dict[str, Any]], house_spec: str, stem:
 #: Stable short reasons for invalid episodes (``--dry-run`` counts them), by a phrase of the error.
 _REASONS: tuple[tuple[str, str], ...] = (
     ("not on the traversable area", "start off the traversable area"),
+    ("on the navmesh the robot moves on", "goal reachable only through SemExp's dilation"),
     ("is reachable from the start", "no goal reachable from the start"),
     ("lies at the start's height", "no floor at the start's height"),
     ("is not in the maps file", "scene not in the maps file"),
@@ -532,9 +533,34 @@ def validate_spec(spec: EpisodeSpec) -> str | None:
         goal = GoalDistance(house, instance_ids=spec.goal_instance_ids, radius=radius)
         if not math.isfinite(goal.to_success(xy, success)):
             return f"no '{spec.target}' of {house.name} is reachable from the start {list(spec.start[:2])}"
+        if house.success_rule == "semexp" and not _moves_to(sim, xy, goal.success_region(success)):
+            return (f"no '{spec.target}' of {house.name} is reachable from the start {list(spec.start[:2])} "
+                    "on the navmesh the robot moves on (channel 0): the two join only through SemExp's "
+                    "2-cell dilation of it, which its distances are measured on")
     except Exception as exc:  # noqa: BLE001 - bad input: reported, never aborts
         return f"cannot load house or goals: {type(exc).__name__}: {exc}"
     return None
+
+
+def _moves_to(sim: Any, xy: Any, region: Any) -> bool:
+    """True when a robot placed at ``xy`` (snapped as ``Simulator.reset`` snaps it) can drive into
+    ``region`` ((H, W) bool success cells) over the simulator's free space: its 8-connected piece
+    holds a region cell (the simulator's sub-steps and slides pass a diagonal link of two cells).
+
+    SemExp measures distances on channel 0 dilated by 2 cells, which bridges gaps of the navmesh
+    the robot cannot drive through: a start drawn beyond such a gap has a finite distance and no
+    way to the goal."""
+    import numpy as np
+    from scipy import ndimage
+
+    free = sim.free
+    start = xy if sim.is_free(xy) else sim.nearest_free(xy)
+    if start is None:
+        return False
+    rc = sim.house.nav.world_to_cell(np.asarray(start, dtype=np.float64))
+    labels, _ = ndimage.label(free, structure=np.ones((3, 3), dtype=bool))
+    piece = labels[rc[0], rc[1]]
+    return bool(piece > 0 and (labels[np.asarray(region, dtype=bool)] == piece).any())
 
 
 def read_specs(path: str | Path) -> list[EpisodeSpec]:

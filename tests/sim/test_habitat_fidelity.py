@@ -366,3 +366,17 @@ def test_a_procthor_houses_file_anywhere_runs_by_file_and_line(shared_data, tmp_
     shutil.copy(mine, tmp_path / "copy.jsonl.gz")
     with pytest.raises(Exception, match="out of range"):
         load_house(f"{tmp_path / 'copy.jsonl.gz'}#9")
+
+
+def test_a_goal_joined_to_the_start_only_through_semexps_dilation_is_invalid(shared_data):
+    from hiconav.eval.sources import EpisodeSpec, invalid_reason, validate_spec
+
+    # Woodbine's toilet (the report floors' episode 4 at seed 0): SemExp's distance, on channel 0
+    # dilated by 2 cells, is finite (16.2 m), but no piece of channel 0 that the robot can drive
+    # on joins the start to the toilet's success region: recorded invalid, with the reason
+    toilet = EpisodeSpec("gibson:Woodbine/0/4", "gibson:Woodbine/0", "toilet", (-1.175, -3.305, 2.75), (13,))
+    error = validate_spec(toilet)
+    assert error is not None and "only through SemExp's" in error
+    assert invalid_reason(error) == "goal reachable only through SemExp's dilation"
+    bed = EpisodeSpec("gibson:Woodbine/0/3", "gibson:Woodbine/0", "bed", (-2.075, -3.205, 0.95), (12,))
+    assert validate_spec(bed) is None
