@@ -455,6 +455,15 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
     from hiconav.sim.episodes import Episode, instruction_for
 
     house = load_house(spec.house)
+    if house.success_rule == "semexp":
+        # a finite SemExp distance may run through its 2-cell dilation of the navmesh alone, where
+        # the robot cannot drive: the dry run's check, so that a run records what it would count
+        from hiconav.errors import DataError
+        from hiconav.eval.sources import validate_spec
+
+        error = validate_spec(spec)
+        if error:
+            raise DataError(error, field="start")
     start = Pose2D(*map(float, spec.start))
     episode = Episode(spec.episode_id, house.name, start, spec.target, tuple(spec.goal_instance_ids),
                       float(spec.geodesic_distance), spec.instruction or instruction_for(spec.target),

@@ -380,3 +380,9 @@ def test_a_goal_joined_to_the_start_only_through_semexps_dilation_is_invalid(sha
     assert invalid_reason(error) == "goal reachable only through SemExp's dilation"
     bed = EpisodeSpec("gibson:Woodbine/0/3", "gibson:Woodbine/0", "bed", (-2.075, -3.205, 0.95), (12,))
     assert validate_spec(bed) is None
+    # a run records it as the dry run counts it: invalid, not a failure of the robot
+    from hiconav.errors import DataError
+    from hiconav.mission import run_episode
+
+    with pytest.raises(DataError, match="only through SemExp's"):
+        run_episode(toilet)
