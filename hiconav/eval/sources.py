@@ -527,13 +527,14 @@ def validate_spec(spec: EpisodeSpec) -> str | None:
         sim = Simulator(house)  # no renderer until a frame is asked for
         radius, success = sim.config.robot_radius, sim.config.success_distance
         xy = np.asarray(spec.start[:2], dtype=np.float64)
-        if not sim.is_free(xy) and sim.nearest_free(xy) is None:
+        placed = xy if sim.is_free(xy) else sim.nearest_free(xy)
+        if placed is None:
             return f"start {list(spec.start[:2])} is not on the traversable area of {house.name} " \
                    "(start off the robot's free space)"
         goal = GoalDistance(house, instance_ids=spec.goal_instance_ids, radius=radius)
         if not math.isfinite(goal.to_success(xy, success)):
             return f"no '{spec.target}' of {house.name} is reachable from the start {list(spec.start[:2])}"
-        if house.success_rule == "semexp" and not _moves_to(sim, xy, goal.success_region(success)):
+        if house.success_rule == "semexp" and not _moves_to(sim, placed, goal.success_region(success)):
             return (f"no '{spec.target}' of {house.name} is reachable from the start {list(spec.start[:2])} "
                     "on the navmesh the robot moves on (channel 0): the two join only through SemExp's "
                     "2-cell dilation of it, which its distances are measured on")
@@ -543,8 +544,8 @@ def validate_spec(spec: EpisodeSpec) -> str | None:
 
 
 def _moves_to(sim: Any, xy: Any, region: Any) -> bool:
-    """True when a robot placed at ``xy`` (snapped as ``Simulator.reset`` snaps it) can drive into
-    ``region`` ((H, W) bool success cells) over the simulator's free space: its 8-connected piece
+    """True when a robot placed at ``xy`` (a free point: the start as ``Simulator.reset`` snaps it)
+    can drive into ``region`` ((H, W) bool success cells) over the simulator's free space: its 8-connected piece
     holds a region cell (the simulator's sub-steps and slides pass a diagonal link of two cells).
 
     SemExp measures distances on channel 0 dilated by 2 cells, which bridges gaps of the navmesh
@@ -553,12 +554,8 @@ def _moves_to(sim: Any, xy: Any, region: Any) -> bool:
     import numpy as np
     from scipy import ndimage
 
-    free = sim.free
-    start = xy if sim.is_free(xy) else sim.nearest_free(xy)
-    if start is None:
-        return False
-    rc = sim.house.nav.world_to_cell(np.asarray(start, dtype=np.float64))
-    labels, _ = ndimage.label(free, structure=np.ones((3, 3), dtype=bool))
+    rc = sim.house.nav.world_to_cell(np.asarray(xy, dtype=np.float64))
+    labels, _ = ndimage.label(sim.free, structure=np.ones((3, 3), dtype=bool))
     piece = labels[rc[0], rc[1]]
     return bool(piece > 0 and (labels[np.asarray(region, dtype=bool)] == piece).any())
 

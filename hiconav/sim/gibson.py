@@ -281,8 +281,8 @@ def load_gibson_file(path: Path | str, scene: str, floor: int, *, name: str | No
     objects: list[SimObject] = []
     quads: list[QuadSet] = []
     footprints: dict[int, np.ndarray] = {}
-    any_object = np.zeros_like(nav_mask)
-    nav_mask = clean_floor(nav_mask, sem[1:16].any(axis=0))
+    any_object = sem[1:16].any(axis=0)
+    nav_mask = clean_floor(nav_mask, any_object)
     # where an obstacle may stand (``beyond_radius``): the walls and clutter, and the labelled
     # objects, whose cells reach right up to the navmesh where the scan's projection of an object
     # is wider than what blocks the agent (about a tenth of the object cells of the 25 floors; drawn
@@ -293,7 +293,6 @@ def load_gibson_file(path: Path | str, scene: str, floor: int, *, name: str | No
         labels, n = ndimage.label(sem[k], structure=EIGHT)
         if n == 0:
             continue
-        any_object |= sem[k]
         z0, z1 = EXTRUSION[cat]
         slices = ndimage.find_objects(labels)
         for lab, sl in enumerate(slices, start=1):
