@@ -552,12 +552,11 @@ def _moves_to(sim: Any, xy: Any, region: Any) -> bool:
     the robot cannot drive through: a start drawn beyond such a gap has a finite distance and no
     way to the goal."""
     import numpy as np
-    from scipy import ndimage
+
+    from hiconav.sim.geodesic import driving_pieces, reaching_pieces
 
     rc = sim.house.nav.world_to_cell(np.asarray(xy, dtype=np.float64))
-    labels, _ = ndimage.label(sim.free, structure=np.ones((3, 3), dtype=bool))
-    piece = labels[rc[0], rc[1]]
-    return bool(piece > 0 and (labels[np.asarray(region, dtype=bool)] == piece).any())
+    return bool(reaching_pieces(driving_pieces(sim.free), region)[rc[0], rc[1]])
 
 
 def read_specs(path: str | Path) -> list[EpisodeSpec]:

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from hiconav.errors import DataError
-from hiconav.sim.geodesic import GoalDistance, distance_mask, house_graph
+from hiconav.sim.geodesic import GoalDistance, distance_mask, driving_pieces, house_graph, reaching_pieces
 from hiconav.sim.house import House
 from hiconav.sim.viewpoints import MIN_VIEW_PIXELS, viewable_instances
 from hiconav.types import Pose2D
@@ -83,7 +83,8 @@ def _resolve(house: House | str) -> House:
 def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: float = 0.18,
                       min_distance: float = 1.5, max_distance: float = 30.0,
                       categories: tuple[str, ...] | None = None,
-                      min_view_pixels: int | None = MIN_VIEW_PIXELS) -> list[Episode]:
+                      min_view_pixels: int | None = MIN_VIEW_PIXELS,
+                      success_distance: float | None = None) -> list[Episode]:
     """``n`` episodes in ``house``; deterministic for a given (house, n, seed).
 
     The target is drawn uniformly among the categories in ``categories`` (default
@@ -98,6 +99,11 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
     keeps only goals with view points). An object drawn inside its receptacle's box shows in no
     pixel from anywhere; a category whose every instance is hidden is not drawn. ``None`` skips
     the check (every instance is a goal, as before the check existed).
+
+    Under "semexp", distances are measured on SemExp's 2-cell dilation of the navmesh, which
+    bridges gaps the robot cannot drive through; a start is drawn only where the robot's own
+    free space (the navmesh, 8-connected) joins a goal's success region (``success_distance``
+    m, default the simulator's), as Habitat's generator keeps only starts with a navmesh path to the goal.
     """
     house = _resolve(house)
     semexp = house.success_rule == "semexp"
@@ -114,6 +120,11 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
     fields: dict[str, tuple[GoalDistance, np.ndarray]] = {}
     usable: list[str] = []
     graph = house_graph(house, radius)
+    pieces = driving_pieces(graph.mask) if semexp else None
+    if success_distance is None:
+        from hiconav.sim.config import SimConfig
+
+        success_distance = SimConfig().success_distance
     sim = None
     if min_view_pixels is not None:
         from hiconav.sim.simulator import Simulator
@@ -129,6 +140,8 @@ def generate_episodes(house: House | str, n: int, seed: int = 0, *, radius: floa
             gd = GoalDistance(house, instance_ids=ids, radius=radius)
             ok = graph.mask & np.isfinite(gd.field) & (gd.field >= min_distance) & \
                 (gd.field <= max_distance)
+            if pieces is not None:
+                ok &= reaching_pieces(pieces, gd.success_region(success_distance))
             cells = np.argwhere(ok)
             if len(cells):
                 fields[cat] = (gd, cells)

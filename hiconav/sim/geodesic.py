@@ -164,6 +164,26 @@ def distance_mask(house: House, radius: float) -> np.ndarray:
     return mask
 
 
+def driving_pieces(free: np.ndarray) -> np.ndarray:
+    """(H, W) int labels of the 8-connected pieces of the robot-centre cells ``free`` (0 elsewhere).
+
+    The simulator's sub-steps and slides pass a diagonal link of two cells, so a robot moves
+    within one such piece and never leaves it."""
+    labels, _ = ndimage.label(np.asarray(free, dtype=bool), structure=np.ones((3, 3), dtype=bool))
+    return labels
+
+
+def reaching_pieces(pieces: np.ndarray, region: np.ndarray) -> np.ndarray:
+    """(H, W) bool: the cells of those ``pieces`` (``driving_pieces``) that hold a cell of
+    ``region`` ((H, W) bool): where a robot placed can drive into the region.
+
+    Distances measured on a looser mask (SemExp's 2-cell dilation of the navmesh) bridge gaps the
+    robot cannot drive through, so a finite distance alone does not say the goal is reachable."""
+    ids = np.unique(pieces[np.asarray(region, dtype=bool)])
+    ids = ids[ids > 0]
+    return np.isin(pieces, ids) if ids.size else np.zeros(pieces.shape, dtype=bool)
+
+
 def house_graph(house: House, radius: float) -> GridGraph:
     """The graph of the robot-centre cells of a house for a robot radius (cached on the house)."""
     key = ("graph", round(radius, 6))

@@ -386,3 +386,32 @@ def test_a_goal_joined_to_the_start_only_through_semexps_dilation_is_invalid(sha
 
     with pytest.raises(DataError, match="only through SemExp's"):
         run_episode(toilet)
+
+
+def test_generated_gibson_starts_lie_where_the_robot_can_drive_to_the_goal(shared_data):
+    from hiconav.eval.sources import validate_spec
+    from hiconav.sim.episodes import generate_episodes
+    from hiconav.sim.geodesic import driving_pieces, reaching_pieces
+
+    # Woodbine's toilet is cut off on channel 0 from most of the floor (the test above): a start is
+    # drawn only on a piece of the robot's free space that holds the goal's success region, as
+    # Habitat's generator keeps only starts with a navmesh path; the dry run's check then holds
+    house = load_house("gibson:Woodbine/0")
+    episodes = generate_episodes(house, 40, seed=0)
+    pieces = driving_pieces(centre_free(house, 0.18))
+    assert {ep.target for ep in episodes} >= {"toilet", "bed"}
+    for ep in episodes:
+        region = GoalDistance(house, ep).success_region(1.0)
+        rc = house.nav.world_to_cell(np.array([ep.start.x, ep.start.y]))
+        assert reaching_pieces(pieces, region)[rc[0], rc[1]], ep.episode_id
+    from hiconav.eval.sources import generate_for_house
+
+    assert all(validate_spec(spec) is None for spec in generate_for_house("gibson:Woodbine/0", 16, 0))
+    # the rule: a piece counts only when it holds a region cell
+    lone = np.zeros((5, 9), dtype=bool)
+    lone[1:4, 1:3] = True
+    lone[1:4, 5:8] = True
+    region = np.zeros_like(lone)
+    region[2, 6] = True
+    assert np.array_equal(reaching_pieces(driving_pieces(lone), region), lone & (np.arange(9) >= 5))
+    assert not reaching_pieces(driving_pieces(lone), np.zeros_like(lone)).any()
