@@ -101,6 +101,10 @@ def test_openness_measures_the_unknown_pocket_depth() -> None:  # eq. 19
     assert cm.c_s == pytest.approx([h_pocket / 3.0, 1.0])
     # same distance and heading from the robot: the confined pocket is cheaper by w_f (1 - c_s)
     assert cm.M[0, 2] - cm.M[0, 1] == pytest.approx(4.0 * (1.0 - h_pocket / 3.0), abs=0.05)
+    # the default weight (0, chosen on the Gibson tune floors) still measures c_s but weighs it not
+    cm = cost_matrix(g, np.array([5.0, 6.5]), 0.0, np.zeros(2), fs, CostConfig(stride=1, h_max=3.0))
+    assert cm.c_s == pytest.approx([h_pocket / 3.0, 1.0])
+    assert cm.M[0, 2] == pytest.approx(cm.M[0, 1], abs=0.05)
 
 
 def test_unreachable_frontiers_are_dropped() -> None:
