@@ -52,9 +52,9 @@ class CostConfig(BaseModel):
     v_max: float = Field(0.5, gt=0.0, description="max linear speed (m/s), eq. 17")
     xi_dot_max: float = Field(0.8, gt=0.0, description="max yaw rate (rad/s), eq. 17")
     w_c: float = Field(1.0, ge=0.0, description="weight of the motion-consistency term c_c (s/rad), eq. 18, 20")
-    w_f: float = Field(0.0, ge=0.0, description="weight of the openness term c_s (s), eq. 19, 20. The paper "
-                       "gives no value; 0 was chosen on the Gibson tune floors (416 episodes: 17 up, 6 down "
-                       "against 1) and is neutral on ProcTHOR train; 1 weighs a confined pocket first")
+    w_f: float = Field(0.0, ge=0.0, description="weight of the openness term c_s (s), eq. 19, 20: above 0 a "
+                       "confined unknown pocket is visited first. The paper gives no value; 0 was chosen on the "
+                       "Gibson tune floors (docs/results_history.md, stop 59)")
     h_max: float = Field(3.0, gt=0.0, description="truncation of the ray-cast openness h_k (m), eq. 19")
     min_speed: float = Field(0.05, ge=0.0, description="below this |v_0| (m/s) c_c is 0 (no heading)")
     stride: int = Field(2, ge=1, description="the geodesic Dijkstra runs on the grid coarsened "
