@@ -17,7 +17,7 @@ import numpy as np
 from hiconav.actors.node import Node
 from hiconav.actors.runtime import NodeActor
 
-from hiconav.messages import PlanMsg, RuledOut, TaskMsg, WorldSnapshot
+from hiconav.messages import PlanMsg, RuledOut, TargetRejected, TaskMsg, WorldSnapshot
 from hiconav.types import Frontier
 
 
@@ -55,10 +55,23 @@ class ExplorationNode(Node):
         self.ruled_out: frozenset[int] = frozenset()  # target-category nodes the reasoning ruled out
         self.on(TaskMsg, self._on_task)
         self.on(RuledOut, lambda m, now: setattr(self, "ruled_out", frozenset(m.object_ids)))
+        # nodes the mission's verification rejected for good (the oracle's spurious boxes, a
+        # look-alike): no more target evidence than the ones the reasoning layer ruled out
+        self.rejected: frozenset[int] = frozenset()
+        # candidates set aside only as out of reach (no view point on the map yet): they draw the
+        # search, until a later verdict on them says otherwise
+        self.out_of_reach: frozenset[int] = frozenset()
+        self.on(TargetRejected, self._on_rejected)
+
+    def _on_rejected(self, msg: TargetRejected, now: float) -> None:
+        oid = int(msg.object_id)
+        if msg.permanent:
+            self.rejected = self.rejected | {oid}
+        self.out_of_reach = self.out_of_reach | {oid} if msg.out_of_reach else self.out_of_reach - {oid}
 
     def _on_task(self, msg: TaskMsg, now: float) -> None:
         self.task = msg.task
-        self.ruled_out = frozenset()
+        self.ruled_out = self.rejected = self.out_of_reach = frozenset()
 
     def tick(self, now: float) -> None:
         snap = self.take(WorldSnapshot)
@@ -73,7 +86,8 @@ class ExplorationNode(Node):
         self._last_pose, self._last_stamp = pose, now
         if self.planner is not None and self.task is not None:
             plan = self.planner.plan(snap.grid, frontiers, snap.memory, self.task, pose, velocity,
-                                     self.similarity, now, ruled_out=self.ruled_out)
+                                     self.similarity, now,
+                                     ruled_out=self.ruled_out, drawn=self.out_of_reach, rejected=self.rejected)
         else:
             order = sorted(frontiers, key=lambda f: (math.hypot(f.viewpoint[0] - pose.x, f.viewpoint[1] - pose.y), f.id))
             plan = NearestPlan(order[0] if order else None, tuple(f.id for f in order))

@@ -4,7 +4,7 @@ Owns the ``MissionTree`` and its ``MissionContext`` (the blackboard belongs to t
 Incoming results (task, world snapshot, exploration plan, hypotheses, navigation status, health
 alerts) are written into the context; after each tick the context's requests become messages:
 ``ParseRequest`` -> reasoning, ``GoalMsg``/``StopRequest`` -> control, ``TargetRejected`` ->
-reasoning. When the tree finishes it reports ``MissionFinished`` to the runtime. On stop the
+reasoning and exploration. When the tree finishes it reports ``MissionFinished`` to the runtime. On stop the
 running branch is preempted (``terminate(INVALID)`` all the way down).
 """
 
@@ -116,7 +116,8 @@ class MissionNode(Node):
                 self.emit(dest, msg)
         ctx.outbox.clear()
         for oid, reason in ctx.rejections[self._sent_rejections:]:
-            self.emit("reasoning", TargetRejected(oid, reason, now))
+            self.emit(("reasoning", "exploration"), TargetRejected(oid, reason, now, oid in ctx.rejected,
+                                                                        oid in ctx.out_of_reach))
         self._sent_rejections = len(ctx.rejections)
 
     def tick(self, now: float) -> None:

@@ -222,11 +222,17 @@ class ActorFailed:
 
 @dataclass(frozen=True)
 class TargetRejected:
-    """Mission -> Reasoning: verification rejected this object node (a false positive): search on."""
+    """Mission -> Reasoning, Exploration: verification rejected this object node (a false
+    positive: search on), for good (``permanent``) or deferred for a while; ``out_of_reach``:
+    deferred only because no view point or approach cell of it could be reached. Exploration
+    stops treating a node rejected for good as target evidence, and draws the search toward
+    one out of reach."""
 
     object_id: int
     reason: str
     stamp: float = 0.0
+    permanent: bool = False
+    out_of_reach: bool = False
 
 
 @dataclass(frozen=True)

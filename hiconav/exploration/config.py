@@ -32,6 +32,13 @@ class UtilityConfig(BaseModel):
     sigma_min: float = Field(0.5, gt=0.0, description="lower clip of sigma_j (m): tiny boxes still "
                              "spread context over a room part")
     sigma_max: float = Field(3.0, gt=0.0, description="upper clip of sigma_j (m)")
+    reach_sigma: float = Field(0.0, ge=0.0, description="sigma_j (m) of a target candidate that verification set "
+                               "aside as out of reach (no view point of it on the map yet) is at least this: it "
+                               "draws the frontiers on the way to it, not only those within its own extent (0: as "
+                               "other objects)")
+    exclude_rejected: bool = Field(False, description="nodes the mission's verification rejected for good are no "
+                                   "target evidence: S_struct leaves them out as it leaves out the ones the reasoning "
+                                   "layer ruled out")
     similarity_floor: float = Field(0.45, description="s_j = max(0, similarity - floor): text embedders give "
                                     "unrelated labels ~0.4-0.5 (MiniLM), which would make S_struct count "
                                     "objects instead of relevant ones; 0.45 suits MiniLM (see report)")

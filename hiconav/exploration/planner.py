@@ -120,7 +120,8 @@ class ExplorationPlanner:
     def plan(self, grid: GridLike, frontiers: Sequence[Frontier], snapshot: SnapshotLike | None,
              task: TaskSpec, pose: Pose2D, velocity_xy: np.ndarray | Sequence[float],
              similarity: Callable[[str, str], float] | None, now: float = 0.0,
-             ruled_out: Collection[int] = ()) -> ExplorationPlan:
+             ruled_out: Collection[int] = (), drawn: Collection[int] = (),
+             rejected: Collection[int] = ()) -> ExplorationPlan:
         """Order the frontiers and pick the mid-term goal.
 
         grid: the current occupancy grid (snapshot); frontiers: from the FrontierTracker (stable
@@ -130,7 +131,10 @@ class ExplorationPlanner:
         target label, 0 otherwise); now: stamp copied into the plan; ruled_out: ids of memory
         objects that are no evidence of the target (instances of its category that the reasoning
         layer judged not to be the described one): S_struct leaves them out, or the robot would
-        be drawn back, frontier after frontier, to the wrong instances it has already seen.
+        be drawn back, frontier after frontier, to the wrong instances it has already seen;
+        rejected: ids of nodes the mission's verification rejected for good (left out like the
+        ruled-out ones when ``exclude_rejected``); drawn: ids of target candidates the mission set aside as out of reach (no view point on
+        the map yet): their field reaches ``reach_sigma`` (``utility.object_peaks``).
         """
         if similarity is None:
             similarity = _exact_label_match
@@ -139,8 +143,8 @@ class ExplorationPlanner:
         previous = self.goal_id
         frontiers = list(frontiers)
         objects = tuple(getattr(snapshot, "objects", ())) if snapshot is not None else ()
-        if ruled_out:
-            skip = set(ruled_out)
+        skip = set(ruled_out) | (set(rejected) if ucfg.exclude_rejected else set())
+        if skip:
             objects = tuple(o for o in objects if getattr(o, "id", None) not in skip)
         anchors = tuple(getattr(snapshot, "anchors", ())) if snapshot is not None else ()
         ids = [f.id for f in frontiers]
@@ -149,7 +153,8 @@ class ExplorationPlanner:
             return ExplorationPlan(None, (), {}, {}, previous is not None, "none", stamp=now,
                                    seconds=time.perf_counter() - t0)
         centroids = np.array([np.asarray(f.centroid, float)[:2] for f in frontiers])
-        S, s_struct, s_vis = frontier_utility(centroids, objects, anchors, task, similarity, ucfg)
+        S, s_struct, s_vis = frontier_utility(centroids, objects, anchors, task, similarity, ucfg,
+                                              drawn=frozenset(drawn) - skip)
         W_all = utility_weights(S, ucfg.beta, ucfg.weight_min_range)  # eq. 16
         weights = {i: float(w) for i, w in zip(ids, W_all)}
         utilities = {i: float(s) for i, s in zip(ids, S)}

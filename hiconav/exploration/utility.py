@@ -27,7 +27,7 @@ the small Protocols below. This module must not touch the grid, costs or the sol
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from typing import Protocol
 
 import numpy as np
@@ -97,9 +97,13 @@ def object_sigma(box_min: np.ndarray, box_max: np.ndarray, config: UtilityConfig
     return float(object_sigmas(box_min, box_max, config))
 
 
-def object_peaks(objects: Sequence[ObjectLike], scorer: LabelScorer, config: UtilityConfig
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def object_peaks(objects: Sequence[ObjectLike], scorer: LabelScorer, config: UtilityConfig,
+                 drawn: Collection[int] = ()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per object: centre xy (m, 2) world, boosted peak s~_j (m,) (eq. 11), sigma_j (m,) (eq. 10).
+
+    ``drawn``: ids of target candidates set aside as out of reach (seen, often in part or from
+    afar, with no view point on the map yet): their sigma_j is at least ``reach_sigma``, so that
+    the frontiers on the way to them weigh, not only those within their box's extent.
 
     Vectorised over the objects (the planner evaluates this for every plan, with ~100 objects);
     the label terms are scored once per distinct label."""
@@ -112,6 +116,9 @@ def object_peaks(objects: Sequence[ObjectLike], scorer: LabelScorer, config: Uti
     sigma = object_sigmas(lo, hi, config)
     by_label: dict[str, float] = {}
     peak = np.zeros(m)
+    if drawn and config.reach_sigma > 0.0:
+        pulled = np.array([getattr(o, "id", None) in drawn for o in objects], dtype=bool)
+        sigma = np.where(pulled, np.maximum(sigma, config.reach_sigma), sigma)
     for j, o in enumerate(objects):
         s = by_label.get(o.label)
         if s is None:
@@ -125,12 +132,12 @@ def object_peaks(objects: Sequence[ObjectLike], scorer: LabelScorer, config: Uti
 
 
 def structural_utility(points_xy: np.ndarray, objects: Sequence[ObjectLike], scorer: LabelScorer,
-                       config: UtilityConfig) -> np.ndarray:
-    """S_struct at points_xy (n, 2) world m -> (n,) (eq. 10-12)."""
+                       config: UtilityConfig, drawn: Collection[int] = ()) -> np.ndarray:
+    """S_struct at points_xy (n, 2) world m -> (n,) (eq. 10-12); ``drawn``: see ``object_peaks``."""
     points_xy = np.asarray(points_xy, dtype=float).reshape(-1, 2)
     if not objects or points_xy.shape[0] == 0:
         return np.zeros(points_xy.shape[0])
-    oxy, peak, sigma = object_peaks(objects, scorer, config)
+    oxy, peak, sigma = object_peaks(objects, scorer, config, drawn)
     d2 = ((points_xy[:, None, :] - oxy[None, :, :]) ** 2).sum(-1)  # (n, m)
     return (peak[None, :] * np.exp(-d2 / (2.0 * sigma[None, :] ** 2))).sum(axis=1)  # eq. 10, 12
 
@@ -180,16 +187,17 @@ def visual_utility(points_xy: np.ndarray, anchors: Sequence[AnchorLike], scorer:
 
 
 def frontier_utility(points_xy: np.ndarray, objects: Sequence[ObjectLike], anchors: Sequence[AnchorLike],
-                     task: TaskSpec, similarity: Similarity, config: UtilityConfig | None = None
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                     task: TaskSpec, similarity: Similarity, config: UtilityConfig | None = None,
+                     drawn: Collection[int] = ()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """S (eq. 9), S_struct (eq. 12), S_vis (eq. 13) at points_xy (n, 2) -> three (n,) arrays.
 
-    The ablation switches use_struct / use_vis zero the corresponding term.
+    The ablation switches use_struct / use_vis zero the corresponding term. ``drawn``: ids of
+    target candidates out of reach (``object_peaks``).
     """
     cfg = config or UtilityConfig()
     scorer = LabelScorer(task, similarity)
     pts = np.asarray(points_xy, dtype=float).reshape(-1, 2)
-    s_struct = structural_utility(pts, objects, scorer, cfg) if cfg.use_struct else np.zeros(len(pts))
+    s_struct = structural_utility(pts, objects, scorer, cfg, drawn) if cfg.use_struct else np.zeros(len(pts))
     s_vis = visual_utility(pts, anchors, scorer, cfg) if cfg.use_vis else np.zeros(len(pts))
     return cfg.lambda1 * s_struct + cfg.lambda2 * s_vis, s_struct, s_vis  # eq. 9
 

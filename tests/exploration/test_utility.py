@@ -159,3 +159,34 @@ def test_similarity_floor_removes_the_embedder_baseline() -> None:
     assert visual_utility(pts, [make_anchor(0, 0, 0.0, 1.0, ("sofa",))], scorer(), cfg)[0] == 0.0
     assert visual_utility(pts, [make_anchor(0, 0, 0.0, 1.0, ("sofa", "lamp"))], scorer(),
                           cfg)[0] == pytest.approx(0.4 - 0.35)
+
+
+def test_a_candidate_out_of_reach_draws_the_frontiers_on_the_way_to_it() -> None:
+    """reach_sigma: a target's box seen from afar (a sliver) spreads its field no farther than
+    sigma_min, and the frontier through which the way to it goes, 3 m off, reads 0; once
+    verification has set it aside as out of reach (``drawn``) that frontier reads the target's
+    field at 3 m. Other objects, and the same box not drawn, keep their sigma."""
+    from dataclasses import dataclass as _dc
+
+    @_dc(frozen=True)
+    class Node:
+        id: int
+        label: str
+        center: np.ndarray
+        box_min: np.ndarray
+        box_max: np.ndarray
+
+    def node(i, obj):
+        return Node(i, obj.label, obj.center, obj.box_min, obj.box_max)
+
+    sliver = node(1, make_object("bed", (4.0, 0.0), (0.05, 0.3, 0.2)))
+    lamp = node(2, make_object("nightstand", (-4.0, 10.0), (0.05, 0.3, 0.2)))
+    pts = np.array([[1.0, 0.0], [-1.0, 10.0]])  # 3 m from each
+    cfg = UtilityConfig(similarity_floor=0.0, gamma=1.0, reach_sigma=2.0)
+    plain = structural_utility(pts, [sliver, lamp], scorer(), cfg)
+    assert plain[0] < 1e-6 and plain[1] < 1e-6
+    drawn = structural_utility(pts, [sliver, lamp], scorer(), cfg, drawn={1})
+    assert drawn[0] == pytest.approx(1.0 * math.exp(-9.0 / 8.0))
+    assert drawn[1] == pytest.approx(plain[1], abs=1e-6)
+    off = structural_utility(pts, [sliver, lamp], scorer(), UtilityConfig(similarity_floor=0.0, gamma=1.0), drawn={1})
+    assert off[0] == pytest.approx(plain[0])  # reach_sigma 0: as other objects
