@@ -196,3 +196,26 @@ def test_frontiers_reachable_only_one_cell_thinner_are_costed_so_when_nothing_el
     assert out.goal is not None and out.goal.id == far.id and out.order == (far.id,)
     out = planner().plan(corridor_grid(4), [far], None, TASK, Pose2D(1.0, 1.5, 0.0), np.zeros(2), similarity, now=1.0)
     assert out.goal is None and out.dropped == (far.id,)
+
+
+def test_a_target_out_of_reach_draws_the_frontier_on_the_way_to_it_and_a_rejected_one_can_be_left_out() -> None:
+    """A bed glimpsed 3.5 m beyond frontier B (a sliver of box, sigma_min) gives B nothing and the
+    nearer frontier A goes first; once verification set it aside as out of reach (``drawn``) B is
+    the goal. With ``exclude_rejected`` a node rejected for good is no evidence at all."""
+    from types import SimpleNamespace
+
+    o = make_object("bed", (-2.0, 5.0), (0.05, 0.3, 0.2))
+    bed = SimpleNamespace(id=3, label=o.label, center=o.center, box_min=o.box_min, box_max=o.box_max)
+    snap = Snapshot(objects=(bed,))
+    cfg = ExplorationConfig(cost=CostConfig(stride=1), utility=UtilityConfig(reach_sigma=2.0))
+
+    def go(config, **sets):
+        return ExplorationPlanner(config).plan(room(), [A, B], snap, TASK, Pose2D(6.0, 5.0, 0.0), np.zeros(2),
+                                               similarity, now=1.0, **sets)
+
+    assert go(cfg).goal.id == A.id and go(cfg).s_struct[B.id] < 1e-6
+    drawn = go(cfg, drawn={3})
+    assert drawn.goal.id == B.id and drawn.s_struct[B.id] > 0.1
+    assert go(cfg, drawn={3}, rejected={3}).goal.id == B.id  # rejections count only when asked
+    excluding = cfg.model_copy(update={"utility": UtilityConfig(reach_sigma=2.0, exclude_rejected=True)})
+    assert go(excluding, drawn={3}, rejected={3}).goal.id == A.id
