@@ -32,10 +32,10 @@ class UtilityConfig(BaseModel):
     sigma_min: float = Field(0.5, gt=0.0, description="lower clip of sigma_j (m): tiny boxes still "
                              "spread context over a room part")
     sigma_max: float = Field(3.0, gt=0.0, description="upper clip of sigma_j (m)")
-    reach_sigma: float = Field(0.0, ge=0.0, description="sigma_j (m) of a target candidate that verification set "
+    reach_sigma: float = Field(2.0, ge=0.0, description="sigma_j (m) of a target candidate that verification set "
                                "aside as out of reach (no view point of it on the map yet) is at least this: it "
                                "draws the frontiers on the way to it, not only those within its own extent (0: as "
-                               "other objects)")
+                               "other objects). Chosen on the Gibson tune floors (docs/results_history.md, stop 60)")
     exclude_rejected: bool = Field(False, description="nodes the mission's verification rejected for good are no "
                                    "target evidence: S_struct leaves them out as it leaves out the ones the reasoning "
                                    "layer ruled out")

@@ -188,5 +188,6 @@ def test_a_candidate_out_of_reach_draws_the_frontiers_on_the_way_to_it() -> None
     drawn = structural_utility(pts, [sliver, lamp], scorer(), cfg, drawn={1})
     assert drawn[0] == pytest.approx(1.0 * math.exp(-9.0 / 8.0))
     assert drawn[1] == pytest.approx(plain[1], abs=1e-6)
-    off = structural_utility(pts, [sliver, lamp], scorer(), UtilityConfig(similarity_floor=0.0, gamma=1.0), drawn={1})
+    off = structural_utility(pts, [sliver, lamp], scorer(), UtilityConfig(similarity_floor=0.0, gamma=1.0, reach_sigma=0.0),
+                             drawn={1})
     assert off[0] == pytest.approx(plain[0])  # reach_sigma 0: as other objects
