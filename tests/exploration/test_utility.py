@@ -166,18 +166,10 @@ def test_a_candidate_out_of_reach_draws_the_frontiers_on_the_way_to_it() -> None
     sigma_min, and the frontier through which the way to it goes, 3 m off, reads 0; once
     verification has set it aside as out of reach (``drawn``) that frontier reads the target's
     field at 3 m. Other objects, and the same box not drawn, keep their sigma."""
-    from dataclasses import dataclass as _dc
-
-    @_dc(frozen=True)
-    class Node:
-        id: int
-        label: str
-        center: np.ndarray
-        box_min: np.ndarray
-        box_max: np.ndarray
+    from types import SimpleNamespace
 
     def node(i, obj):
-        return Node(i, obj.label, obj.center, obj.box_min, obj.box_max)
+        return SimpleNamespace(id=i, label=obj.label, center=obj.center, box_min=obj.box_min, box_max=obj.box_max)
 
     sliver = node(1, make_object("bed", (4.0, 0.0), (0.05, 0.3, 0.2)))
     lamp = node(2, make_object("nightstand", (-4.0, 10.0), (0.05, 0.3, 0.2)))
