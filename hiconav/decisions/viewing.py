@@ -282,6 +282,11 @@ def next_view_move(settings: VerifySettings, *, close: bool, sent: bool, state: 
     cell was sent), ``closing`` (the goal in flight is a closer cell), ``stalled`` (no progress
     toward the goal for ``stall_s``; read only where ``stall_matters``).
 
+    - Close and there at a closer cell (no view cell was on the map when it was sent), after
+      ``reposition_after`` frames that could not show the object either: a view cell on the map
+      grown since, else a way through unknown floor, else a deferral until the map around the
+      object grows (which draws exploration toward it, ``exploration.utility.reach_sigma``);
+      glancing at an object behind a wall from the wrong side of it shows nothing.
     - Close and there, after ``reposition_after`` frames that could not show the object: the
       object is hidden from this cell (behind furniture the memory now knows, or out of the
       field of view): another view cell, and after ``view_cells`` cells a deferral ("no view
@@ -294,6 +299,12 @@ def next_view_move(settings: VerifySettings, *, close: bool, sent: bool, state: 
       then a deferral until the map around the object grows."""
     there = close and state in DONE
     if there and unseen >= settings.reposition_after:
+        if closing and has_cell:
+            # a closer cell (no view cell was on the map) that shows nothing either: the object
+            # lies behind what the robot now sees; a view cell on the grown map, a way through
+            # unknown floor, or a deferral until the map around it grows, not glances at it
+            return ViewMove(tries=("view", "unknown", "remap"), exclude_cell=True, reset_unseen=True,
+                            stop_closing=True)
         if excluded >= settings.view_cells:
             return ViewMove(reason="no view cell shows it")
         if has_cell:

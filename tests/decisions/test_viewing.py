@@ -163,6 +163,16 @@ def test_a_cell_that_cannot_show_the_object_is_set_aside_for_another_then_glance
     assert move.tries == ("view", "glance") and move.exclude_cell and move.reset_unseen and move.another_cell
 
 
+def test_a_closer_cell_that_cannot_show_the_object_leads_on_to_a_view_cell_unknown_floor_or_the_map_not_glances():
+    move = view.next_view_move(S, close=True, sent=True, state="reached", unseen=S.reposition_after, excluded=0,
+                               has_cell=True, closing=True, stalled=False)
+    assert move.tries == ("view", "unknown", "remap") and move.stop_closing and move.reset_unseen
+    assert "glance" not in move.tries and move.reason is None
+    before = view.next_view_move(S, close=True, sent=True, state="reached", unseen=S.reposition_after - 1, excluded=0,
+                                 has_cell=True, closing=True, stalled=False)
+    assert before.tries == ("glance",)  # frames that may still show it: glance on
+
+
 def test_after_view_cells_cells_that_cannot_show_it_the_object_is_deferred_as_hidden():
     move = view.next_view_move(S, close=True, sent=True, state="failed", unseen=S.reposition_after,
                                excluded=S.view_cells, has_cell=True, closing=False, stalled=False)
