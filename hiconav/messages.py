@@ -225,8 +225,8 @@ class TargetRejected:
     """Mission -> Reasoning, Exploration: verification rejected this object node (a false
     positive: search on), for good (``permanent``) or deferred for a while; ``out_of_reach``:
     deferred only because no view point or approach cell of it could be reached. Exploration
-    stops treating a node rejected for good as target evidence, and draws the search toward
-    one out of reach."""
+    draws the search toward a node out of reach (``exploration.utility.reach_sigma``) and, with
+    ``exploration.utility.exclude_rejected``, leaves one rejected for good out of S_struct."""
 
     object_id: int
     reason: str

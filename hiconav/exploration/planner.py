@@ -133,8 +133,9 @@ class ExplorationPlanner:
         layer judged not to be the described one): S_struct leaves them out, or the robot would
         be drawn back, frontier after frontier, to the wrong instances it has already seen;
         rejected: ids of nodes the mission's verification rejected for good (left out like the
-        ruled-out ones when ``exclude_rejected``); drawn: ids of target candidates the mission set aside as out of reach (no view point on
-        the map yet): their field reaches ``reach_sigma`` (``utility.object_peaks``).
+        ruled-out ones when ``exclude_rejected``); drawn: ids of target candidates the mission
+        set aside as out of reach (no view point on the map yet): their field reaches at least
+        ``reach_sigma`` (``utility.object_peaks``).
         """
         if similarity is None:
             similarity = _exact_label_match
