@@ -56,7 +56,7 @@ class ExplorationNode(Node):
         self.on(TaskMsg, self._on_task)
         self.on(RuledOut, lambda m, now: setattr(self, "ruled_out", frozenset(m.object_ids)))
         # nodes the mission's verification rejected for good (the oracle's spurious boxes, a
-        # look-alike): no more target evidence than the ones the reasoning layer ruled out
+        # look-alike): the planner leaves them out of S_struct with exclude_rejected
         self.rejected: frozenset[int] = frozenset()
         # candidates set aside only as out of reach (no view point on the map yet): they draw the
         # search, until a later verdict on them says otherwise
