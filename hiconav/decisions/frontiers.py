@@ -53,7 +53,8 @@ class PlanView:
     ``order``: the WTRP order of frontier ids; ``goal_id``: the plan's goal frontier (None: none);
     ``stamp``: the clock time the plan was made (s); ``dropped``: ids of frontiers the planner
     left out of ``order``: no path to them on the map's lethal layer, or beyond its
-    ``max_frontiers``.
+    ``max_frontiers``; ``newest``: the plan was made from the newest world snapshot the mission
+    holds (no frame has come since).
     """
 
     frontiers: tuple[Any, ...]
@@ -61,16 +62,19 @@ class PlanView:
     goal_id: int | None
     stamp: float
     dropped: tuple[int, ...] = ()
+    newest: bool = False
 
     @staticmethod
-    def of(msg: Any) -> PlanView | None:
-        """The view of a ``PlanMsg`` (None: no plan yet); a plan without an order has none."""
+    def of(msg: Any, world_seq: int | None = None) -> PlanView | None:
+        """The view of a ``PlanMsg`` (None: no plan yet); a plan without an order has none.
+        ``world_seq``: the seq of the newest world snapshot the mission holds (None: unknown)."""
         if msg is None:
             return None
         goal = getattr(msg.plan, "goal", None)
+        newest = world_seq is not None and int(getattr(msg, "snapshot_seq", -1)) >= int(world_seq)
         return PlanView(tuple(msg.frontiers), tuple(getattr(msg.plan, "order", ()) or ()),
                         None if goal is None else goal.id, msg.stamp,
-                        tuple(getattr(msg.plan, "dropped", ()) or ()))
+                        tuple(getattr(msg.plan, "dropped", ()) or ()), newest)
 
 
 @dataclass
@@ -155,10 +159,10 @@ def facing_yaw(viewpoint: np.ndarray, centroid: np.ndarray) -> float | None:
 
 
 def push_goal(centroid: np.ndarray, pose: Pose2D | None, pushed: Sequence[Spot],
-              s: ExploreSettings) -> tuple[np.ndarray, float] | None:
+              s: ExploreSettings, radius: float | None = None) -> tuple[np.ndarray, float] | None:
     """(goal xy, yaw) ``push_m`` beyond a spent frontier's ``centroid`` ((2,) world m), away from
     the robot, or None: pushing is off, there is no pose, the centroid is beyond ``push_radius``
-    or was pushed into before (within ``spent_radius`` of one of ``pushed``).
+    (``radius`` where given) or was pushed into before (within ``spent_radius`` of one of ``pushed``).
 
     A frontier can outlive the visit to its viewpoint: the floor close to the robot is below the
     camera's field of view, a wall nearer than the minimum depth reads nothing. Driving into it
@@ -169,7 +173,7 @@ def push_goal(centroid: np.ndarray, pose: Pose2D | None, pushed: Sequence[Spot],
     robot = np.array([pose.x, pose.y])
     d = centroid - robot
     dist = float(np.hypot(*d))
-    if dist > s.push_radius or near_any(centroid, pushed, s.spent_radius):
+    if dist > (s.push_radius if radius is None else radius) or near_any(centroid, pushed, s.spent_radius):
         return None
     yaw = math.atan2(d[1], d[0]) if dist > PUSH_HEADING_MIN_M else pose.yaw
     goal = centroid + s.push_m * np.array([math.cos(yaw), math.sin(yaw)])
@@ -183,18 +187,26 @@ def look_goal(pose: Pose2D) -> FrontierGoal:
 
 
 def settle_reached(reached: list[tuple[np.ndarray, float]], plan: PlanView | None, spent: list[Spot],
-                   s: ExploreSettings) -> tuple[list[tuple[np.ndarray, float]], list[Spot]]:
+                   s: ExploreSettings, now: float | None = None,
+                   idle: bool = False) -> tuple[list[tuple[np.ndarray, float]], list[Spot]]:
     """Judge reached viewpoints ((viewpoint (2,) world m, clock time reached)) on ``plan``: a
     viewpoint is spent when a plan made ``spent_after_s`` or more after the visit still has a
     frontier viewpoint within ``spent_radius`` of it (the visit did not clear the frontier).
     Returns (still waiting for a newer plan, newly spent spots); appends the spent ones to
-    ``spent``. A viewpoint that a later plan shows cleared is dropped."""
+    ``spent``. A viewpoint that a later plan shows cleared is dropped.
+
+    While the robot stands ``idle`` (no goal in flight), a plan made from the newest frame
+    (``plan.newest``) is as new as any will be until the robot acts: a robot whose camera frames
+    come only with its actions (a lockstep simulator, a driver that publishes on motion) would
+    otherwise wait for ever on a plan that its own waiting keeps from coming. Such a plan judges
+    a viewpoint once ``spent_after_s`` have passed since the visit (clock ``now``)."""
     if plan is None or not reached:
         return reached, []
     views = np.array([f.viewpoint for f in plan.frontiers], dtype=np.float64).reshape(-1, 2)
     waiting, settled = [], []
     for xy, t in reached:
-        if plan.stamp < t + s.spent_after_s:
+        stale = idle and plan.newest and now is not None and now >= t + s.spent_after_s
+        if plan.stamp < t + s.spent_after_s and not stale:
             waiting.append((xy, t))
         elif len(views) and float(np.min(np.hypot(*(views - xy).T))) <= s.spent_radius:
             spot = (float(xy[0]), float(xy[1]))
@@ -229,18 +241,24 @@ def pick_frontier(plan: PlanView | None, visited: Collection[int], pose: Pose2D 
     return None
 
 
-def pick_squeeze(plan: PlanView | None, ledger: ExploreLedger,
-                 s: ExploreSettings) -> tuple[Any, np.ndarray, float | None] | None:
-    """(frontier id, viewpoint, yaw) of the first frontier of the plan's order that failed, else of
+def pick_squeeze(plan: PlanView | None, ledger: ExploreLedger, s: ExploreSettings,
+                 pose: Pose2D | None = None) -> tuple[Any, np.ndarray, float | None] | None:
+    """(frontier id, goal xy, yaw) of the first frontier of the plan's order that failed, else of
     the first the planner left out of its order (``plan.dropped``), that was not squeezed yet (its
-    centroid then joins ``ledger.squeezed_frontiers``), or None.
+    centroid then joins ``ledger.squeezed_frontiers``), else a push into the first spent frontier
+    never pushed into (``push_goal`` from wherever the robot stands; the centroid joins
+    ``ledger.pushed_frontiers`` too), or None.
 
     The map's grid can close a passage the robot fits: a goal through unknown floor lets the
     navigator plan on the lethal layer and then on it one cell thinner, a last resort before
     "no frontier left". A doorway first seen from across the room is such a passage: the floor
     seen through it is a narrow wedge, tight at the doorway, and the frontiers along the wedge have
     no path on the lethal layer, so the planner leaves them out of its order; they are squeezed
-    toward too, after the failed ones."""
+    toward too, after the failed ones. A doorway whose viewpoint the robot reached without
+    clearing it (spent) is pushed into only while the robot stands within ``push_radius`` of it;
+    a robot that went on elsewhere first and then ran out of frontiers goes back and pushes
+    through it (its goal beyond the centroid, through unknown floor), rather than ending the
+    search beside a door it never tried."""
     if plan is None or not s.squeeze:
         return None
     frontiers = {f.id: f for f in plan.frontiers}
@@ -255,6 +273,23 @@ def pick_squeeze(plan: PlanView | None, ledger: ExploreLedger,
             continue
         ledger.squeezed_frontiers.append((float(centroid[0]), float(centroid[1])))
         return fid, xy, facing_yaw(xy, centroid)
+    if not s.push_through or pose is None:
+        return None
+    for fid in plan.order:
+        f = frontiers.get(fid)
+        if f is None or not near_any(np.asarray(f.viewpoint, dtype=np.float64), ledger.spent_viewpoints,
+                                     s.spent_radius):
+            continue
+        centroid = np.asarray(f.centroid, dtype=np.float64)
+        if near_any(centroid, ledger.squeezed_frontiers, s.spent_radius):
+            continue
+        push = push_goal(centroid, pose, ledger.pushed_frontiers, s, radius=math.inf)
+        if push is None:
+            continue
+        spot = (float(centroid[0]), float(centroid[1]))
+        ledger.squeezed_frontiers.append(spot)
+        ledger.pushed_frontiers.append(spot)
+        return fid, push[0], push[1]
     return None
 
 
@@ -351,7 +386,7 @@ class FrontierFollower:
             self.start_look = False
         if ledger.start_looks < s.start_look_turns:
             return self._look_around_start(in_flight, pose, now, ledger, s, log)
-        self.reached, spent = settle_reached(self.reached, plan, ledger.spent_viewpoints, s)
+        self.reached, spent = settle_reached(self.reached, plan, ledger.spent_viewpoints, s, now, idle=not in_flight)
         log += [f"frontier viewpoint ({x:.2f}, {y:.2f}) spent: reached, not cleared" for x, y in spent]
         if self.push_at is not None and in_flight:
             ledger.last_frontier_time = now
@@ -397,7 +432,7 @@ class FrontierFollower:
                          log: list[str]) -> ExploreStep:
         """No frontier to go to: squeeze toward a failed one, or cancel the goal in flight and,
         idle for ``max_idle_s``, release the deferred candidates or fail; else look around."""
-        squeeze = pick_squeeze(plan, ledger, s)
+        squeeze = pick_squeeze(plan, ledger, s, pose)
         if squeeze is not None:
             fid, xy, yaw = squeeze
             goal = FrontierGoal("squeeze", float(xy[0]), float(xy[1]), yaw, s.goal_tolerance, int(fid),

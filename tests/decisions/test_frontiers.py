@@ -95,6 +95,50 @@ def test_a_reached_viewpoint_waits_for_a_plan_made_spent_after_s_after_the_visit
     assert len(waiting) == 1 and new == []
 
 
+def test_a_robot_standing_idle_judges_its_reached_viewpoint_on_the_plan_of_its_newest_frame():
+    """A robot whose frames come only with its actions gets no newer plan while it waits: the plan
+    made from its newest frame judges the visit once spent_after_s have passed."""
+    reached = [(np.array([1.0, 1.0]), 2.0)]
+    stale = PlanView((_frontier(7, (1.0, 1.0), (2, 1)),), (7,), None, 1.5, newest=True)
+    # a goal in flight, or too soon after the visit, or a frame newer than the plan: it waits
+    assert len(settle_reached(reached, stale, [], S, 3.0, idle=False)[0]) == 1
+    assert len(settle_reached(reached, stale, [], S, 2.2, idle=True)[0]) == 1
+    older = PlanView(stale.frontiers, stale.order, None, 1.5, newest=False)
+    assert len(settle_reached(reached, older, [], S, 3.0, idle=True)[0]) == 1
+    spent: list = []
+    waiting, new = settle_reached(reached, stale, spent, S, 3.0, idle=True)
+    assert waiting == [] and new == [(1.0, 1.0)] and spent == [(1.0, 1.0)]
+
+
+def test_a_plan_is_the_newest_when_made_from_the_newest_world_snapshot():
+    from types import SimpleNamespace
+
+    msg = SimpleNamespace(plan=SimpleNamespace(order=(1,), goal=None), frontiers=(), stamp=4.0, snapshot_seq=12)
+    assert PlanView.of(msg, 12).newest and not PlanView.of(msg, 13).newest and not PlanView.of(msg).newest
+
+
+def test_explored_out_the_robot_goes_back_to_push_through_a_spent_frontier_it_never_pushed_into():
+    """A doorway whose viewpoint was reached without clearing it, left for another frontier while
+    the robot was near it: with nothing else left, the robot pushes through it from afar."""
+    plan = _plan(_frontier(4, (5.0, 0.0), (6.0, 0.0)))
+    ledger = _ledger(spent_viewpoints=[(5.0, 0.0)])
+    pose = Pose2D(0.0, 0.0, 0.0)
+    assert pick_frontier(plan, set(), pose, ledger, S) is None  # beyond push_radius: skipped
+    fid, xy, yaw = pick_squeeze(plan, ledger, S, pose)
+    assert fid == 4 and xy.tolist() == pytest.approx([6.0 + S.push_m, 0.0]) and yaw == pytest.approx(0.0)
+    assert ledger.pushed_frontiers == [(6.0, 0.0)] and ledger.squeezed_frontiers == [(6.0, 0.0)]
+    assert pick_squeeze(plan, ledger, S, pose) is None  # once per centroid
+    # one pushed into before, or pushing off, or no pose: nothing to go back to
+    assert pick_squeeze(plan, _ledger(spent_viewpoints=[(5.0, 0.0)], pushed_frontiers=[(6.0, 0.0)]), S, pose) is None
+    assert pick_squeeze(plan, _ledger(spent_viewpoints=[(5.0, 0.0)]), ExploreSettings(push_through=False),
+                        pose) is None
+    assert pick_squeeze(plan, _ledger(spent_viewpoints=[(5.0, 0.0)]), S) is None
+    # the follower sends it as a squeeze through unknown floor before it idles
+    f, ledger = FrontierFollower(), _ledger(spent_viewpoints=[(5.0, 0.0)])
+    step = f.step(None, pose, 1.0, plan, ledger, (), NO_START)
+    assert step.goal.kind == "squeeze" and step.goal.frontier == 4 and step.goal.through_unknown
+
+
 def test_a_reached_viewpoint_whose_frontier_cleared_is_forgotten_not_spent():
     reached = [(np.array([1.0, 1.0]), 2.0)]
     waiting, new = settle_reached(reached, _plan(_frontier(7, (4.0, 1.0), (5, 1)), stamp=3.0), [], S)

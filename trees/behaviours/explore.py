@@ -47,8 +47,8 @@ class Explore(MissionBehaviour):
                                ctx.spent_viewpoints, ctx.pushed_frontiers, ctx.failed_frontiers,
                                ctx.squeezed_frontiers, self._asks_left(), int(ctx.stranded))
         state = None if self._seq is None else ctx.nav_state(self._seq)
-        step = self._follower.step(state, ctx.pose, ctx.now(), PlanView.of(ctx.plan), ledger, ctx.deferred,
-                                   self.settings)
+        plan = PlanView.of(ctx.plan, None if ctx.world is None else ctx.world.seq)
+        step = self._follower.step(state, ctx.pose, ctx.now(), plan, ledger, ctx.deferred, self.settings)
         ctx.last_frontier_time, ctx.start_looks = ledger.last_frontier_time, ledger.start_looks
         ctx.look_spot, ctx.looks_here = ledger.look_spot, ledger.looks_here
         for text in step.log:
