@@ -5,9 +5,11 @@ The exploration layer plans frontiers and their WTRP order; this module decides 
 does with them, tick by tick: go to the first frontier of the order not yet visited (its
 viewpoint, facing its centroid), skip frontiers seen from viewpoints that did not clear them
 (spent), push once into a spent frontier beside the robot, squeeze toward failed frontiers
-through unknown floor when nothing else is left, turn in place to look around at the start and
-where no frontier is known, and keep the mission's idle clock (no frontier for ``max_idle_s``:
-exploration fails).
+through unknown floor when nothing else is left (and push through spent frontiers never pushed
+into, from wherever the robot stands), turn in place to look around at the start and where no
+frontier is known, and keep the mission's idle clock (no frontier for ``max_idle_s``:
+exploration fails). A robot standing idle judges its reached viewpoints on the plan of its
+newest frame: a robot whose frames come only with its actions gets no newer one.
 
 Inputs are plain: the plan's frontiers and order (``PlanView``), the robot's pose, the clock
 time, the ``decisions.explore`` settings and the mission-wide ledger of exploration
