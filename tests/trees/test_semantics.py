@@ -1621,3 +1621,39 @@ def test_explore_turns_beside_an_undecided_described_instance_once_then_explores
             ctx.nav = NavStatus(goal.seq, "reached", 0.0)
         assert (kinds[:2] == ["look", "look"] and kinds[2] != "look") is lingers, kinds
         assert (3 in ctx.lingered) is lingers
+
+
+def test_explore_standing_idle_judges_its_reached_viewpoint_on_the_plan_of_its_newest_frame(tmp_path):
+    """A robot whose frames come only with its actions gets no newer plan while it waits: Explore
+    judged the visit "spent" never, failed idle, and a retried Explore re-picked the same viewpoint
+    until the task clock ran out. Now the plan of its newest frame judges it."""
+    clock = Clock()
+    ctx = _ctx(clock, decisions=DecisionsConfig(explore=ExploreSettings(start_look_turns=0, look_turns=0)))
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), seq=7)
+    ctx.plan = replace(_plan_at(0.0, (0, (3.0, 2.0))), snapshot_seq=6)
+    tree = MissionTree(_write(tmp_path, "root:\n  Explore: {}\n"), ctx)
+    tree.tick()
+    first = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+    clock.t = 5.0
+    ctx.nav = NavStatus(first.seq, "reached", 0.0)
+    ctx.world = world(Pose2D(3.0, 2.0, 0.0), seq=8)
+    ctx.plan = replace(_plan_at(4.9, (0, (3.0, 2.0))), snapshot_seq=8)  # made from the arrival frame
+    tree.tick()
+    assert ctx.spent_viewpoints == []  # too soon after the visit
+    clock.t = 6.0  # no frame since: the plan is as new as any will be until the robot acts
+    tree.tick()
+    assert ctx.spent_viewpoints == [(3.0, 2.0)]
+    # a newer frame that the plan has not caught up with: judged on the next plan, not this one
+    clock2 = Clock()
+    ctx2 = _ctx(clock2, decisions=DecisionsConfig(explore=ExploreSettings(start_look_turns=0, look_turns=0)))
+    ctx2.plan = replace(_plan_at(0.0, (0, (3.0, 2.0))), snapshot_seq=0)
+    tree2 = MissionTree(_write(tmp_path, "root:\n  Explore: {}\n"), ctx2)
+    tree2.tick()
+    clock2.t = 5.0
+    ctx2.nav = NavStatus([m for m in ctx2.outbox if isinstance(m, GoalMsg)][-1].seq, "reached", 0.0)
+    ctx2.world = world(Pose2D(3.0, 2.0, 0.0), seq=9)
+    ctx2.plan = replace(_plan_at(4.9, (0, (3.0, 2.0))), snapshot_seq=8)
+    tree2.tick()
+    clock2.t = 6.0
+    tree2.tick()
+    assert ctx2.spent_viewpoints == []
