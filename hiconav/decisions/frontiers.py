@@ -207,8 +207,8 @@ def settle_reached(reached: list[tuple[np.ndarray, float]], plan: PlanView | Non
     views = np.array([f.viewpoint for f in plan.frontiers], dtype=np.float64).reshape(-1, 2)
     waiting, settled = [], []
     for xy, t in reached:
-        stale = idle and plan.newest and now is not None and now >= t + s.spent_after_s
-        if plan.stamp < t + s.spent_after_s and not stale:
+        none_newer = idle and plan.newest and now is not None and now >= t + s.spent_after_s
+        if plan.stamp < t + s.spent_after_s and not none_newer:
             waiting.append((xy, t))
         elif len(views) and float(np.min(np.hypot(*(views - xy).T))) <= s.spent_radius:
             spot = (float(xy[0]), float(xy[1]))
