@@ -104,9 +104,10 @@ class VerifySettings(_Section):
     blocker_shrink: float = _f(0.05, "other objects' boxes shrink by this a side horizontally before they may "
                                      "hide the candidate: box edges are loose (m)", 0.0, 1.0)
     min_fresh_views: int = _f(2, "frames in view that observed the candidate needed to confirm it", 0, 100)
-    recent_view_s: float = _f(5.0, "frames of a candidate the reasoning layer put forward, taken this long before "
-                                   "its verification began from within the view ring, count as its views (0: only "
-                                   "frames after it began)", 0.0, 600.0)
+    recent_view_s: float = _f(600.0, "frames of a candidate the reasoning layer put forward, taken from within the "
+                                     "view ring this long before its verification began (sensor time: the frames' "
+                                     "stamps), count as its views; 600: any frame of a mission (0: only frames "
+                                     "after it began)", 0.0, 600.0)
     min_detection_rate: float = _f(0.5, "fresh views per frame with the candidate in view needed to confirm it",
                                    0.0, 1.0)
     max_view_frames: int = _f(8, "frames in view after which a rarely detected candidate is rejected", 1, 10000)

@@ -111,9 +111,10 @@ class Tally:
 
 
 def recent_close(anchor: Any, *, since: float, box_min: np.ndarray, box_max: np.ndarray, close: float) -> bool:
-    """Whether ``anchor`` is a frame taken before a verification began that it may count: taken
-    at clock ``since`` or later (the start less ``recent_view_s``), its camera within ``close``
-    m (the view ring) of the candidate's box (3,) world.
+    """Whether ``anchor`` is a frame taken before a verification began that it may count: stamped
+    ``since`` or later (sensor time: the stamp of the newest frame when it began, less
+    ``recent_view_s``), its camera within ``close`` m (the view ring) of the candidate's box (3,)
+    world.
 
     A robot that drove up to a candidate saw it from where a view cell would stand before the
     verification began (a search that comes upon it on its way); judging only the frames after

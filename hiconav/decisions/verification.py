@@ -112,6 +112,7 @@ class Verification:
         self.tally = Tally()
         self.glances = self.closer_moves = self.unknown_moves = 0
         self.closing = False
+        self.start_stamp: float | None = None  # sensor time of the newest frame at the first judge
 
     @property
     def judging(self) -> bool:
@@ -139,13 +140,18 @@ class Verification:
         the start only: the frame that made a spurious box would count as its first view. Frames
         from the wider close distance are not taken: from there a look-alike is read as the
         target about as often as not."""
+        if self.start_stamp is None:
+            # frames carry their sensor's stamps, and a stepped clock keeps another time (a 0.1 s
+            # tick per action of 0.5 s): a window over frames is measured in the frames' own time,
+            # from the newest frame the memory held when the verification began
+            self.start_stamp = float(getattr(memory, "stamp", self.start))
         self.close = gap <= close_distance(settings, ring)
         if not self.close:
             return None
         anchors, objects = tuple(getattr(memory, "anchors", ()) or ()), memory.objects
         earlier = None if settings.recent_view_s <= 0.0 or getattr(cand, "source", None) != HYPOTHESIS else partial(
-            recent_close, since=self.start - settings.recent_view_s, box_min=cand.box_min, box_max=cand.box_max,
-            close=ring)
+            recent_close, since=self.start_stamp - settings.recent_view_s, box_min=cand.box_min,
+            box_max=cand.box_max, close=ring)
         frames, self.last_anchor = frames_since(anchors, self.last_anchor, earlier)
         targets, support, hiding = evidence_inputs(settings, memory, task_targets, cand)
         if frames:

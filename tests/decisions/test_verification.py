@@ -111,6 +111,29 @@ def test_frames_taken_close_just_before_the_verification_of_a_hypothesis_began_c
     assert v.judge(recent, 1.0, RING, far, None, hypothesis, ["bed"], "bed") is None and v.tally.in_view == 0
 
 
+def test_the_window_of_earlier_frames_is_measured_in_the_frames_own_time_not_the_clock():
+    """A stepped clock ticks 0.1 s per action while the frames' stamps advance 0.5 s: a window
+    over frames, measured from the clock's start, took in nearly every frame of the mission. It
+    runs back from the newest frame's stamp when the verification began."""
+    def seen(aid: int, stamp: float) -> Anchor:
+        return Anchor(aid, camera_pose_from_base(Pose2D(3.5, 5.0, 0.0), 0.4), (1,), ("bed",), stamp=stamp)
+
+    @dataclass
+    class Stamped(Memory):
+        stamp: float = 0.0
+
+    memory = Stamped([node(1, "bed", 5, 5)], [seen(9, 50.0), seen(10, 97.0)], stamp=100.0)
+    recent = S.model_copy(update={"recent_view_s": 5.0})
+    hypothesis = Cand(1, "bed", CENTRE, LO, HI, source=verif.HYPOTHESIS)
+    v = verif.Verification(20.0)  # the clock's time: 200 ticks, the frames' 100 s
+    assert v.judge(recent, 1.0, RING, memory, None, hypothesis, ["bed"], "bed") is None
+    assert v.start_stamp == 100.0 and v.tally.in_view == 1 and v.tally.fresh == 1  # anchor 9 is 50 s old
+    wide = S.model_copy(update={"recent_view_s": 60.0})
+    v = verif.Verification(20.0)
+    judged = v.judge(wide, 1.0, RING, memory, None, hypothesis, ["bed"], "bed")
+    assert judged is not None and judged.confirmed and v.tally.in_view == 2
+
+
 def test_fresh_views_of_the_candidate_confirm_it_and_name_no_other_node():
     v = verif.Verification(0.0)
     memory = Memory([node(1, "bed", 5, 5)], [facing_bed(10)])
