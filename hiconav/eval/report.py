@@ -166,6 +166,11 @@ def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
                    "truth, not what the detector reported); after it, the path driven against the shortest "
                    "path from that spot to the success region. Before the view is exploration; after it, "
                    "detection, verification and the approach."), ""]
+        acts = [(name, p) for name, p in ((n, g.get("actions", {})) for n, g in presets.items())
+                if p.get("episodes_measured")]
+        lines += [f"Turns in place, {name}: {p['turns']} of {p['actions']} actions ({_pct(p['turn_share'])}%) over "
+                  f"{p['episodes_measured']} episodes: a turn costs a step of the budget and no path." for name, p in acts]
+        lines += [""] if acts else []
 
     if main is not None and presets.get(main, {}).get("by_target"):
         lines += [f"## Success by target category ({main})", ""]

@@ -75,6 +75,18 @@ def path_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
     }
 
 
+def action_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
+    """How the actions of the episodes that count their turns (``extra["turns"]``, the simulator's
+    count of discrete turns in place) divide: every action, the turns among them and their share.
+    A turn costs a step of the budget (500 in Habitat's ObjectNav) and no path; records without the
+    field (older runs, robots) are left out (``episodes_measured``)."""
+    counted = [r for r in records if isinstance(r.extra, dict) and isinstance(r.extra.get("turns"), int)]
+    actions = int(sum(int(r.steps) for r in counted))
+    turns = int(sum(int(r.extra["turns"]) for r in counted))
+    return {"episodes_measured": len(counted), "actions": actions, "turns": turns,
+            "turn_share": turns / actions if actions > 0 else None}
+
+
 def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
     """Metrics of one set of records (one preset)."""
     valid = [r for r in records if r.failure != Failure.INVALID_EPISODE.value]
@@ -126,6 +138,7 @@ def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
         "failure_rates": {c: (n / len(records) if records else 0.0) for c, n in failures.items()},
         "timing": timing,
         "path": path,
+        "actions": action_split(valid),
         "by_target": by_target,
         "detectors": sorted({r.detector for r in valid if r.detector}),
         "reasoners": sorted({r.reasoner for r in valid if r.reasoner}),

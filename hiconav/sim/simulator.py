@@ -61,6 +61,7 @@ class Simulator:
         self.time = 0.0
         self.path_length = 0.0
         self.collisions = 0
+        self.turns = 0  # discrete turn actions (TURN_LEFT / TURN_RIGHT) this episode
         self.stopped = False
         self._seq = 0
         # instance id + 1 -> watched (-1, no instance, -> slot 0; larger ids clip to the last, False
@@ -110,6 +111,7 @@ class Simulator:
         self.time = 0.0
         self.path_length = 0.0
         self.collisions = 0
+        self.turns = 0  # discrete turn actions (TURN_LEFT / TURN_RIGHT) this episode
         self.stopped = False
         self.first_in_view = None
         return self.observe()
@@ -155,9 +157,11 @@ class Simulator:
         if action == DiscreteAction.MOVE_FORWARD:
             self.collided = self._move(c.forward_step, self.pose.yaw)
         elif action == DiscreteAction.TURN_LEFT:
+            self.turns += 1
             self.pose = Pose2D(self.pose.x, self.pose.y,
                                wrap_angle(self.pose.yaw + math.radians(c.turn_deg)))
         elif action == DiscreteAction.TURN_RIGHT:
+            self.turns += 1
             self.pose = Pose2D(self.pose.x, self.pose.y,
                                wrap_angle(self.pose.yaw - math.radians(c.turn_deg)))
         elif action == DiscreteAction.LOOK_UP:

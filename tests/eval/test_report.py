@@ -73,5 +73,8 @@ def test_the_report_says_where_the_path_went_when_records_carry_the_goal_in_view
     row = next(line for line in text.splitlines() if line.startswith("| full") and "75.0" in line)
     assert row.split(" | ")[1:5] == ["1", "4", "8", "6"]  # successes, shortest, driven, before the view
     assert "2 / 2" in row and "1 / 1" in row  # after: driven / shortest; failures never in view
+    assert "Turns in place" not in text  # these records do not count their turns
+    counted = [EpisodeRecord(**{**r.__dict__, "steps": 100, "extra": {**r.extra, "turns": 45}}) for r in records]
+    assert "Turns in place, full: 90 of 200 actions (45.0%) over 2 episodes" in render_markdown(counted, summarize(counted))
     older = [rec(2, True, 3.0)]  # records written before the field existed: no such section
     assert "## Where the path goes" not in render_markdown(older, summarize(older))

@@ -69,6 +69,17 @@ def test_ablation_deltas_are_paired_on_common_episodes_with_sign() -> None:
     assert s["success_rate"] == pytest.approx(2 / 3)  # top level = the full preset
 
 
+def test_actions_split_counts_the_turns_in_place_of_the_records_that_count_them() -> None:
+    records = [
+        rec(0, success=True, spl=0.5, steps=100, extra={"turns": 40}),
+        rec(1, success=False, spl=0.0, steps=500, extra={"turns": 260}),
+        rec(2, success=True, spl=1.0, steps=30),  # an older record: no such field
+    ]
+    a = summarize(records)["actions"]
+    assert a == {"episodes_measured": 2, "actions": 600, "turns": 300, "turn_share": 0.5}
+    assert summarize([rec(3, success=True, spl=1.0, steps=30)])["actions"]["turn_share"] is None
+
+
 def test_path_split_counts_the_successes_path_before_and_after_the_goal_came_in_view() -> None:
     view = lambda path, to_success: {"goal_in_view": {"steps": 10, "path_m": path, "to_success_m": to_success}}  # noqa: E731
     records = [

@@ -58,11 +58,14 @@ def test_tracker_scores_a_simulated_episode():
     ep = Episode("t", house.name, Pose2D(2.0, 4.0, 0.0), "bed", (0,),
                  GoalDistance(house, ep).distance(np.array([2.0, 4.0])), "find the bed")
     tracker = EpisodeTracker(sim, ep)
+    sim.step(DiscreteAction.TURN_LEFT)
+    sim.step(DiscreteAction.TURN_RIGHT)
     for _ in range(13):  # 3.25 m towards the bed's face at x = 6.0: ends 0.75 m from it
         sim.step(DiscreteAction.MOVE_FORWARD)
     sim.step(DiscreteAction.STOP)
     m = tracker.finish()
     assert tracker.done and m.stopped and m.success
+    assert m.steps == 16 and m.turns == 2
     assert m.path_length == pytest.approx(3.25)
     assert m.final_distance == pytest.approx(0.75, abs=0.06)
     # SPL's l is the way to the success region (1 m short of the bed's face), not to the bed:

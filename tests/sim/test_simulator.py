@@ -38,9 +38,12 @@ def test_forward_and_turns_follow_habitat_steps():
     sim.step(A.LOOK_DOWN)
     assert sim.tilt == pytest.approx(math.radians(-30))
     assert sim.steps == 7 and not sim.stopped
+    assert sim.turns == 3  # the turns in place only: no step forward, look or stop
     sim.step(A.STOP)
-    assert sim.stopped
+    assert sim.stopped and sim.turns == 3
     assert sim.path_length == pytest.approx(0.25)
+    sim.reset(Pose2D(2.0, 3.0, 0.0))
+    assert sim.turns == 0
 
 
 def test_forward_into_a_wall_stops_before_it_and_flags_collision():
