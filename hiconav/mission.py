@@ -489,7 +489,7 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
                                           if e["kind"] == "verify" or (e["kind"] == "unresolved" and e["found"]))),
                "feedback": result.mission_feedback,
                "shortest_to_success": float(m.shortest_to_success),  # SPL's l (docs/evaluation.md)
-               "turns": int(m.turns),  # of the steps, discrete turns in place
+               "turns": m.turns,  # of the steps, discrete turns in place (None: velocity control)
                "goal_in_view": None if m.steps_to_view is None else {
                    "steps": int(m.steps_to_view), "path_m": float(m.path_to_view),
                    "to_success_m": None if m.view_to_success is None or not math.isfinite(m.view_to_success)

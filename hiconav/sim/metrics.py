@@ -61,7 +61,7 @@ class EpisodeMetrics:
     steps_to_view: int | None = None
     path_to_view: float | None = None
     view_to_success: float | None = None
-    turns: int = 0  # of ``steps``, the discrete turns (the rest move, look or stop)
+    turns: int | None = None  # of ``steps``, the discrete turns in place; None: not counted (velocity control)
 
     def to_json(self) -> dict[str, Any]:
         return asdict(self)
@@ -72,7 +72,7 @@ def episode_metrics(episode: Episode, *, final_distance: float, path_length: flo
                     config: SimConfig | None = None,
                     final_to_success: float | None = None,
                     first_in_view: tuple[int, float] | None = None,
-                    view_to_success: float | None = None, turns: int = 0) -> EpisodeMetrics:
+                    view_to_success: float | None = None, turns: int | None = None) -> EpisodeMetrics:
     """Score an episode from its end state (hand-made cases in tests use this directly).
 
     ``shortest_to_success``: the geodesic distance from the start to the success region (SPL's l;
@@ -94,7 +94,7 @@ def episode_metrics(episode: Episode, *, final_distance: float, path_length: flo
         steps_to_view=None if first_in_view is None else int(first_in_view[0]),
         path_to_view=None if first_in_view is None else float(first_in_view[1]),
         view_to_success=None if first_in_view is None or view_to_success is None else float(view_to_success),
-        turns=int(turns))
+        turns=None if turns is None else int(turns))
 
 
 class EpisodeTracker:
@@ -121,4 +121,4 @@ class EpisodeTracker:
                                shortest_to_success=self.shortest_to_success, config=sim.config,
                                final_to_success=self.goal.to_success(sim.pose.xy, sim.config.success_distance),
                                first_in_view=None if view is None else view[:2], view_to_success=to_view,
-                               turns=sim.turns)
+                               turns=sim.turns if sim.velocity_steps == 0 else None)

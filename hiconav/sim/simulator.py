@@ -62,6 +62,7 @@ class Simulator:
         self.path_length = 0.0
         self.collisions = 0
         self.turns = 0  # discrete turn actions (TURN_LEFT / TURN_RIGHT) this episode
+        self.velocity_steps = 0  # velocity commands integrated this episode (no discrete turns then)
         self.stopped = False
         self._seq = 0
         # instance id + 1 -> watched (-1, no instance, -> slot 0; larger ids clip to the last, False
@@ -112,6 +113,7 @@ class Simulator:
         self.path_length = 0.0
         self.collisions = 0
         self.turns = 0  # discrete turn actions (TURN_LEFT / TURN_RIGHT) this episode
+        self.velocity_steps = 0  # velocity commands integrated this episode (no discrete turns then)
         self.stopped = False
         self.first_in_view = None
         return self.observe()
@@ -192,6 +194,7 @@ class Simulator:
                 self.collided = True
         self.collisions += int(self.collided)
         self.steps += 1
+        self.velocity_steps += 1
         self.time += dt
         return self.observe()
 

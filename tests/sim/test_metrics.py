@@ -73,3 +73,10 @@ def test_tracker_scores_a_simulated_episode():
     assert ep.geodesic_distance == pytest.approx(4.0, abs=0.06)
     assert m.shortest_to_success == pytest.approx(ep.geodesic_distance - 1.0, abs=0.06)
     assert m.spl == pytest.approx(m.shortest_to_success / 3.25) and m.spl < 0.95
+    # under velocity control nothing turns in place: the turns are not counted, not zero
+    from hiconav.types import VelocityCommand
+
+    sim.reset(Pose2D(2.0, 4.0, 0.0))
+    tracker = EpisodeTracker(sim, ep)
+    sim.step_velocity(VelocityCommand(0.3, 0.5), 0.1)
+    assert sim.turns == 0 and tracker.finish().turns is None
