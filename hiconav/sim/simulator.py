@@ -56,6 +56,14 @@ class Simulator:
         self._renderer = None
         self.pose = Pose2D(0.0, 0.0, 0.0)
         self.tilt = 0.0  # rad, positive looking up
+        self._seq = 0
+        # instance id + 1 -> watched (-1, no instance, -> slot 0; larger ids clip to the last, False
+        # slot): the goals whose first sighting is recorded, None when none are
+        self._watch: np.ndarray | None = None
+        self._clear_episode()
+
+    def _clear_episode(self) -> None:
+        """Zero what one episode counts (``__init__`` and ``reset``)."""
         self.collided = False
         self.steps = 0
         self.time = 0.0
@@ -64,10 +72,6 @@ class Simulator:
         self.turns = 0  # discrete turn actions (TURN_LEFT / TURN_RIGHT) this episode
         self.velocity_steps = 0  # velocity commands integrated this episode (no discrete turns then)
         self.stopped = False
-        self._seq = 0
-        # instance id + 1 -> watched (-1, no instance, -> slot 0; larger ids clip to the last, False
-        # slot): the goals whose first sighting is recorded, None when none are
-        self._watch: np.ndarray | None = None
         self.first_in_view: tuple[int, float, float, float] | None = None  # (steps, path m, x, y) then
 
     # ----------------------------------------------------------------------------- state
@@ -107,15 +111,7 @@ class Simulator:
             xy = snapped
         self.pose = Pose2D(float(xy[0]), float(xy[1]), wrap_angle(start.yaw))
         self.tilt = float(tilt)
-        self.collided = False
-        self.steps = 0
-        self.time = 0.0
-        self.path_length = 0.0
-        self.collisions = 0
-        self.turns = 0  # discrete turn actions (TURN_LEFT / TURN_RIGHT) this episode
-        self.velocity_steps = 0  # velocity commands integrated this episode (no discrete turns then)
-        self.stopped = False
-        self.first_in_view = None
+        self._clear_episode()
         return self.observe()
 
     # ----------------------------------------------------------------------------- motion
