@@ -42,6 +42,10 @@ class ControlNode(Node):
         self._fresh = False
         self._stop: StopRequest | None = None
         self._cmd_seq = 0
+        # discrete actions commanded, per source of the goal they served (``GoalMsg.source``, the
+        # behaviour that sent it): {"Explore": {"turns": 120, "forward": 150}, ...}
+        self.actions: dict[str, dict[str, int]] = {}
+        self._source = ""
         self.hold_while_reasoning = hold_while_reasoning
         self.hold_until = 0.0
         self.held_ticks = 0
@@ -58,8 +62,17 @@ class ControlNode(Node):
     def _on_goal(self, msg: GoalMsg, now: float) -> None:
         self.navigator.set_goal(msg.goal)
         self.goal_seq = msg.seq
+        self._source = msg.source
         self._set_state("idle" if msg.goal is None else "active", now)
         self._fresh = True  # act on the newest snapshot even if the robot has not moved
+
+    def _count(self, action: DiscreteAction) -> None:
+        """Tally a commanded discrete action under its goal's source: a turn in place (left or
+        right), a forward step, or another action (looking up or down)."""
+        tally = self.actions.setdefault(self._source or "unnamed", {"turns": 0, "forward": 0, "other": 0})
+        kind = ("turns" if action in (DiscreteAction.TURN_LEFT, DiscreteAction.TURN_RIGHT) else
+                "forward" if action == DiscreteAction.MOVE_FORWARD else "other")
+        tally[kind] += 1
 
     def _set_state(self, state: str, now: float) -> None:
         if state != self.state or state == "active":
@@ -91,6 +104,7 @@ class ControlNode(Node):
                 self._set_state("failed", now)
             else:
                 self._command(now, action=action)
+                self._count(action)
         else:
             cmd = self.navigator.step_velocity(snap.grid, snap.pose, self.velocity_dt, now)
             if self.navigator.reached:

@@ -141,11 +141,14 @@ class HypothesisMsg:
 
 @dataclass(frozen=True)
 class GoalMsg:
-    """Mission -> Control: navigate to ``goal`` (None cancels). ``seq`` identifies the request."""
+    """Mission -> Control: navigate to ``goal`` (None cancels). ``seq`` identifies the request;
+    ``source`` names what sent it (the mission tree's behaviour class, e.g. "Explore"), so that
+    the control layer can say which decision its actions served."""
 
     seq: int
     goal: Goal | None
     stamp: float = 0.0
+    source: str = ""
 
 
 @dataclass(frozen=True)

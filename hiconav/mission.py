@@ -147,6 +147,7 @@ class MissionParts:
     detector_name: str
     reasoner_name: str
     fallbacks: list[str] = field(default_factory=list)
+    control: Any = None  # the ControlNode (its ``actions`` tally)
 
 
 def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
@@ -286,7 +287,7 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
 
         nodes.insert(0, RecorderNode(record, spawn=spawn, rate_hz=rates.driver))
     return MissionParts(nodes, sim, driver, mission, reasoning, getattr(detector, "name", "oracle"),
-                        "vlm" if use_vlm else "offline", fallbacks)
+                        "vlm" if use_vlm else "offline", fallbacks, control)
 
 
 # ------------------------------------------------------------------------------------- running
@@ -312,6 +313,9 @@ class MissionResult:
     pauses: list[dict[str, Any]] = field(default_factory=list)  # failsafe pauses of a live robot
     driver: str = "sim"
     mission_feedback: str = ""  # the tree's last words, e.g. "Approach: no reachable approach cell"
+    # discrete actions per behaviour whose goal they served ({"Explore": {"turns", "forward",
+    # "other"}}; ``ControlNode.actions``); None under velocity control, where steps are control ticks
+    actions_by_behaviour: dict[str, dict[str, int]] | None = None
 
     def summary(self) -> dict[str, Any]:
         m = self.metrics
@@ -386,6 +390,9 @@ def run_mission(house: Any, episode: Any, *, seed: int = 0, overrides: dict[str,
                            {k: v for k, v in report.stats.items()}, parts.driver.path, parts.mission.history,
                            parts.reasoning.events, report,
                            mission_feedback=parts.mission.finished.feedback if parts.mission.finished else "")
+    control = parts.control
+    if control is not None and getattr(control, "mode", "") == "discrete":
+        result.actions_by_behaviour = {k: dict(v) for k, v in control.actions.items()}
     if robot is not None:
         result.pauses = list(getattr(parts.driver, "pauses", []))
         result.driver = str(getattr(robot, "name", "robot"))
@@ -490,6 +497,8 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
                "feedback": result.mission_feedback,
                "shortest_to_success": float(m.shortest_to_success),  # SPL's l (docs/evaluation.md)
                "turns": m.turns,  # of the steps, discrete turns in place (None: velocity control)
+               # the actions per behaviour whose goal they served (None: velocity control)
+               "actions_by_behaviour": result.actions_by_behaviour,
                "goal_in_view": None if m.steps_to_view is None else {
                    "steps": int(m.steps_to_view), "path_m": float(m.path_to_view),
                    "to_success_m": None if m.view_to_success is None or not math.isfinite(m.view_to_success)

@@ -70,6 +70,9 @@ class MissionContext:
     reasoning: bool = True
     # decisions.*: the thresholds the behaviours and the decision modules read
     decisions: DecisionsConfig = field(default_factory=DecisionsConfig)
+    # the behaviour class whose tick runs now (``MissionBehaviour.tick``): the source of the goals
+    # it sends, so that the records can say which decision each action served
+    acting: str = ""
     verify: bool = True  # False: VerifyTarget accepts the candidate as is (the 'no_verify' ablation)
     task: TaskSpec | None = None
     world: Any = None  # WorldSnapshot
@@ -171,10 +174,11 @@ class MissionContext:
         self.outbox.append(KeyframeRequest(until, every_s, self.now()))
 
     def send_goal(self, goal: Goal | None) -> int:
-        """Ask the control layer to go to ``goal`` (None cancels); returns the request's seq."""
+        """Ask the control layer to go to ``goal`` (None cancels); returns the request's seq. The
+        request names the behaviour ticking now (``acting``) as its source."""
         self.goal_seq += 1
         self.active_goal = goal
-        self.outbox.append(GoalMsg(self.goal_seq, goal, self.now()))
+        self.outbox.append(GoalMsg(self.goal_seq, goal, self.now(), self.acting))
         return self.goal_seq
 
     def request_stop(self, reason: str) -> None:

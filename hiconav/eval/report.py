@@ -170,6 +170,9 @@ def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
                 if p.get("episodes_measured")]
         lines += [f"Turns in place, {name}: {p['turns']} of {p['actions']} actions ({_pct(p['turn_share'])}%) over "
                   f"{p['episodes_measured']} episodes: a turn costs a step of the budget and no path." for name, p in acts]
+        lines += [f"Actions by the behaviour whose goal they served, {name}: " + ", ".join(
+                  f"{b} {v['actions']} ({_pct(v['share'])}%, {v['turns']} turns)" for b, v in p["by_behaviour"].items())
+                  + "." for name, p in acts if p.get("by_behaviour")]
         lines += [""] if acts else []
 
     if main is not None and presets.get(main, {}).get("by_target"):

@@ -84,7 +84,28 @@ def action_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
     actions = int(sum(int(r.steps) for r in counted))
     turns = int(sum(int(r.extra["turns"]) for r in counted))
     return {"episodes_measured": len(counted), "actions": actions, "turns": turns,
-            "turn_share": turns / actions if actions > 0 else None}
+            "turn_share": turns / actions if actions > 0 else None,
+            "by_behaviour": behaviour_split(counted)}
+
+
+def behaviour_split(records: Sequence[EpisodeRecord]) -> dict[str, dict[str, Any]]:
+    """The actions commanded per behaviour whose goal they served (``extra["actions_by_behaviour"]``,
+    the control layer's tally), most first: each behaviour's actions, turns in place among them,
+    and its share of all the actions so counted. Records without the field are left out."""
+    totals: dict[str, dict[str, int]] = {}
+    for r in records:
+        per = r.extra.get("actions_by_behaviour") if isinstance(r.extra, dict) else None
+        if not isinstance(per, dict):
+            continue
+        for name, tally in per.items():
+            if not isinstance(tally, dict):
+                continue
+            t = totals.setdefault(str(name), {"actions": 0, "turns": 0})
+            t["actions"] += int(sum(int(v) for v in tally.values() if isinstance(v, int)))
+            t["turns"] += int(tally.get("turns", 0) or 0)
+    whole = sum(t["actions"] for t in totals.values())
+    return {name: {**t, "share": t["actions"] / whole if whole else None}
+            for name, t in sorted(totals.items(), key=lambda kv: (-kv[1]["actions"], kv[0]))}
 
 
 def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:

@@ -76,5 +76,11 @@ def test_the_report_says_where_the_path_went_when_records_carry_the_goal_in_view
     assert "Turns in place" not in text  # these records do not count their turns
     counted = [EpisodeRecord(**{**r.__dict__, "steps": 100, "extra": {**r.extra, "turns": 45}}) for r in records]
     assert "Turns in place, full: 90 of 200 actions (45.0%) over 2 episodes" in render_markdown(counted, summarize(counted))
+    assert "Actions by the behaviour" not in render_markdown(counted, summarize(counted))  # not tallied
+    tallied = [EpisodeRecord(**{**r.__dict__, "extra": {**r.extra, "actions_by_behaviour": {
+        "Explore": {"turns": 30, "forward": 60, "other": 0}, "VerifyTarget": {"turns": 9, "forward": 0, "other": 1}}}})
+        for r in counted]
+    assert ("Actions by the behaviour whose goal they served, full: Explore 180 (90.0%, 60 turns), "
+            "VerifyTarget 20 (10.0%, 18 turns).") in render_markdown(tallied, summarize(tallied))
     older = [rec(2, True, 3.0)]  # records written before the field existed: no such section
     assert "## Where the path goes" not in render_markdown(older, summarize(older))

@@ -76,7 +76,7 @@ def test_actions_split_counts_the_turns_in_place_of_the_records_that_count_them(
         rec(2, success=True, spl=1.0, steps=30),  # an older record: no such field
     ]
     a = summarize(records)["actions"]
-    assert a == {"episodes_measured": 2, "actions": 600, "turns": 300, "turn_share": 0.5}
+    assert a == {"episodes_measured": 2, "actions": 600, "turns": 300, "turn_share": 0.5, "by_behaviour": {}}
     assert summarize([rec(3, success=True, spl=1.0, steps=30)])["actions"]["turn_share"] is None
 
 
@@ -94,3 +94,17 @@ def test_path_split_counts_the_successes_path_before_and_after_the_goal_came_in_
     assert p["driven_m"] == pytest.approx(13.0) and p["shortest_m"] == pytest.approx(8.0)
     assert p["before_view_m"] == pytest.approx(6.0) and p["before_view_share"] == pytest.approx(6.0 / 13.0)
     assert p["after_view_m"] == pytest.approx(7.0) and p["after_view_shortest_m"] == pytest.approx(5.0)
+
+
+def test_actions_split_by_the_behaviour_whose_goal_they_served() -> None:
+    records = [
+        rec(0, success=True, spl=0.5, steps=31, extra={"turns": 12, "actions_by_behaviour": {
+            "Explore": {"turns": 10, "forward": 10, "other": 0}, "Approach": {"turns": 2, "forward": 8, "other": 0}}}),
+        rec(1, success=False, spl=0.0, steps=10, extra={"turns": 6, "actions_by_behaviour": {
+            "Explore": {"turns": 6, "forward": 4, "other": 0}}}),
+        rec(2, success=True, spl=1.0, steps=9, extra={"turns": 3, "actions_by_behaviour": None}),  # velocity control
+    ]
+    by = summarize(records)["actions"]["by_behaviour"]
+    assert list(by) == ["Explore", "Approach"]  # most actions first
+    assert by["Explore"] == {"actions": 30, "turns": 16, "share": 0.75}
+    assert by["Approach"] == {"actions": 10, "turns": 2, "share": 0.25}

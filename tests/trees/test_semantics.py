@@ -103,6 +103,19 @@ def test_preemption_by_higher_priority_calls_terminate_and_cancels_the_goal(tmp_
     tree.stop()
 
 
+def test_each_goal_names_the_behaviour_that_sent_it(tmp_path):
+    """The control layer tallies its actions by the goal's source (``GoalMsg.source``)."""
+    ctx = _ctx(Clock())
+    ctx.plan = plan((8.0, 8.0))
+    tree = MissionTree(_write(tmp_path, FIND), ctx)
+    assert tree.tick() == S.RUNNING
+    assert [m.source for m in ctx.outbox if isinstance(m, GoalMsg)] == ["Explore"]
+    tree.stop()
+    ctx, tree, _ = _approach_bed(tmp_path, Pose2D(2.0, 2.0, 0.0))
+    assert [m.source for m in ctx.outbox if isinstance(m, GoalMsg)] == ["Approach"]
+    tree.stop()
+
+
 def test_stopping_a_running_tree_terminates_the_running_leaf(tmp_path):
     clock = Clock()
     ctx = _ctx(clock)

@@ -55,6 +55,13 @@ class MissionBehaviour(py_trees.behaviour.Behaviour):
         for key in self.WRITES:
             self.bb.register_key(key=key, access=py_trees.common.Access.WRITE)
 
+    def tick(self) -> Any:
+        """py_trees' tick, with the context told which behaviour acts (``MissionContext.acting``):
+        the goals sent from ``initialise`` and ``update`` name it as their source."""
+        if self.ctx is not None:
+            self.ctx.acting = type(self).__name__
+        yield from super().tick()
+
     def terminate(self, new_status: Status) -> None:
         self.terminations.append(new_status)
         self.cleanup(new_status)
