@@ -55,7 +55,7 @@ class MissionNode(Node):
                  blackboard: dict[str, Any] | None = None, success_distance: float = 1.0, verify: bool = True,
                  use_memory_labels: bool = True, reasoning: bool = True, record_tree: bool = False,
                  requalify_observations: int = 3, remap_area_m2: float = 1.0,
-                 decisions: DecisionsConfig | None = None) -> None:
+                 decisions: DecisionsConfig | None = None, time_scale: float = 1.0) -> None:
         super().__init__(rate_hz)
         self.tree_source = tree
         self.instruction = instruction
@@ -66,7 +66,11 @@ class MissionNode(Node):
         self.reasoning = reasoning
         self.requalify_observations = requalify_observations
         self.remap_area_m2 = remap_area_m2
-        self.decisions = decisions if decisions is not None else DecisionsConfig()
+        # the decisions' durations are robot time; ``time_scale`` (the clock's seconds per second of
+        # robot time: 1 on a robot, ``hiconav.mission.stepped_time_scale`` on the simulator) puts
+        # them on this actor's clock, the tree's own settings too (``MissionContext.time_scale``)
+        self.time_scale = float(time_scale)
+        self.decisions = (decisions if decisions is not None else DecisionsConfig()).in_clock(self.time_scale)
         self.record_tree = record_tree
         self._now = 0.0
         self.context: MissionContext | None = None
@@ -99,7 +103,8 @@ class MissionNode(Node):
                                       success_distance=self.success_distance, verify=self.verify,
                                       use_memory_labels=self.use_memory_labels, reasoning=self.reasoning,
                                       requalify_observations=self.requalify_observations,
-                                      remap_area_m2=self.remap_area_m2, decisions=self.decisions)
+                                      remap_area_m2=self.remap_area_m2, decisions=self.decisions,
+                                      time_scale=self.time_scale)
         self.tree = MissionTree(self.tree_source, self.context, self.blackboard)
 
     def stop(self, now: float) -> None:

@@ -267,6 +267,9 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
                           requalify_observations=cfg.requalify_observations,
                           remap_area_m2=cfg.remap_area_m2,
                           decisions=area_config(DecisionsConfig, overrides, "decisions"),  # type: ignore[arg-type]
+                          # the decisions' durations are robot time: one to one on a robot; on the
+                          # simulator (either clock) a driver tick carries a whole discrete action
+                          time_scale=1.0 if robot is not None else stepped_time_scale(rates, cfg.control_mode),
                           record_tree=record is not None or spawn)
     nodes = [driver, perception, memory, reasoning, exploration, control, mission]
     for path, kwargs in cfg.extra_actors.items():

@@ -70,6 +70,9 @@ class MissionContext:
     reasoning: bool = True
     # decisions.*: the thresholds the behaviours and the decision modules read
     decisions: DecisionsConfig = field(default_factory=DecisionsConfig)
+    # the clock's seconds per second of robot time: ``decisions`` is on the clock already
+    # (``DecisionsConfig.in_clock``); a duration a tree sets for one node is scaled on reading
+    time_scale: float = 1.0
     # the behaviour class whose tick runs now (``MissionBehaviour.tick``): the source of the goals
     # it sends, so that the records can say which decision each action served
     acting: str = ""

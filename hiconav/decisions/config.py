@@ -7,6 +7,14 @@ from nowhere else: each field has its default, its range and a one-line reason, 
 (``Approach: {distance: 0.9}``), checked against the same field; the shipped trees set none, so
 a ``--config`` file or ``--set decisions.approach.distance=0.9`` changes what the mission does.
 
+Durations are seconds of robot time (``_d`` fields; ``robot_time_fields``): how long a robot
+that makes one discrete action in ``ACTION_SECONDS`` (a 0.25 m step at 0.5 m/s, a 30 degree turn)
+waits, drives or glances. The mission puts them on its clock (``DecisionsConfig.in_clock``): on
+a robot one to one; on the simulator's clocks, where a driver tick (0.1 s at 10 Hz) carries a
+whole action, at a fifth, so that a robot gives a frontier up after the same 150 actions of no
+frontier as the simulator does. ``verify.recent_view_s`` is compared with the frames' own stamps,
+which are robot time already.
+
 The defaults were chosen on ProcTHOR train houses and the Gibson tune floors (README "Results").
 This module holds data only.
 """
@@ -25,6 +33,20 @@ def _f(default: Any, reason: str, ge: float | None = None, le: float | None = No
     return Field(default, ge=ge, le=le, description=reason, **kw)
 
 
+#: ``json_schema_extra`` of a duration in robot time (``_d``)
+ROBOT_TIME = {"time": "robot"}
+
+
+def _d(default: float, reason: str, ge: float | None = None, le: float | None = None) -> Any:
+    """A duration in seconds of robot time (``DecisionsConfig.in_clock`` puts it on the mission's clock)."""
+    return _f(default, f"{reason} (s of robot time)", ge, le, json_schema_extra=ROBOT_TIME)
+
+
+def robot_time_fields(section: type[BaseModel]) -> frozenset[str]:
+    """The fields of a settings section that are durations in robot time."""
+    return frozenset(name for name, f in section.model_fields.items() if f.json_schema_extra == ROBOT_TIME)
+
+
 class _Section(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
 
@@ -32,7 +54,7 @@ class _Section(BaseModel):
 class ParseSettings(_Section):
     """ParseInstruction: waiting for the reasoning layer's decomposition."""
 
-    timeout_s: float = _f(60.0, "no task from the reasoning layer in this long: the mission fails", 0.0,
+    timeout_s: float = _d(300.0, "no task from the reasoning layer in this long: the mission fails", 0.0,
                           MAX_DURATION_S)
 
 
@@ -46,7 +68,7 @@ class TargetSettings(_Section):
 class ExploreSettings(_Section):
     """Explore: following the WTRP order of frontiers (``hiconav.decisions.frontiers``)."""
 
-    max_idle_s: float = _f(15.0, "no frontier for this long: exploration fails (the map is explored out)", 0.0,
+    max_idle_s: float = _d(75.0, "no frontier for this long: exploration fails (the map is explored out)", 0.0,
                            MAX_DURATION_S)
     goal_tolerance: float = _f(0.3, "a frontier viewpoint is reached within this (m)", 0.05, 5.0)
     switch_distance: float = _f(0.5, "re-send a frontier goal whose viewpoint moved this far (m)", 0.0, 10.0)
@@ -57,14 +79,14 @@ class ExploreSettings(_Section):
                                   "so the start room is otherwise known in one direction only", 0, 100)
     spent_radius: float = _f(0.4, "a frontier viewpoint this near a reached one that did not clear its frontier "
                                   "is spent (m)", 0.0, 5.0)
-    spent_after_s: float = _f(0.5, "judge a reached viewpoint on plans made this long after the visit", 0.0, 60.0)
+    spent_after_s: float = _d(2.5, "judge a reached viewpoint on plans made this long after the visit", 0.0, 60.0)
     push_through: bool = _f(True, "drive once into a nearby frontier whose viewpoint did not clear it, as a "
                                   "person steps into a doorway")
     push_radius: float = _f(1.5, "push only into spent frontiers whose centroid is this near the robot (m)",
                             0.0, 10.0)
     push_m: float = _f(0.6, "the push goal lies this far beyond the centroid (m)", 0.0, 5.0)
-    push_s: float = _f(6.0, "clock seconds a push may take before it counts as blocked", 0.1, 600.0)
-    stall_s: float = _f(8.0, "a frontier goal the robot came no nearer to (by progress_m) for this long is "
+    push_s: float = _d(30.0, "a push may take this long before it counts as blocked", 0.1, 3000.0)
+    stall_s: float = _d(40.0, "a frontier goal the robot came no nearer to (by progress_m) for this long is "
                              "skipped: a passage the map shows open that the robot does not fit", 0.1, 600.0)
     stall_near: float = _f(0.35, "within this of a frontier goal the robot is arriving, not stalled (m)", 0.0, 5.0)
     progress_m: float = _f(0.25, "coming this much nearer a goal is progress (stall and idle clocks, m)",
@@ -119,18 +141,18 @@ class VerifySettings(_Section):
                                          "objects low in every frame", 1, 100000)
     view_ray_weight: float = _f(2.0, "1 m nearer the line the candidate was seen along is worth this many m more "
                                      "to drive (0: no preference)", 0.0, 100.0)
-    timeout_s: float = _f(60.0, "no verdict in this long: the candidate is deferred", 0.1, MAX_DURATION_S)
+    timeout_s: float = _d(300.0, "no verdict in this long: the candidate is deferred", 0.1, MAX_DURATION_S)
     support_margin: float = _f(0.15, "target-labelled nodes whose box overlaps the candidate's grown by this "
                                      "support it (m)", 0.0, 2.0)
-    defer_s: float = _f(30.0, "a deferred candidate waits this long (clock s)", 0.0, MAX_DURATION_S)
+    defer_s: float = _d(150.0, "a deferred candidate waits this long", 0.0, MAX_DURATION_S)
     max_deferrals: int = _f(2, "deferrals after which a candidate is rejected for good", 1, 100)
     reposition_after: int = _f(4, "frames that could not show the candidate before trying another view cell",
                                1, 1000)
     view_cells: int = _f(3, "view cells tried before the candidate is deferred as hidden", 1, 100)
     glance_deg: float = _f(35.0, "glances alternate this far left and right of facing the candidate", 0.0, 90.0)
-    keyframe_every_s: float = _f(1.0, "while judging, the memory makes a frame an anchor this often (KeyframeRequest): "
-                                      "a robot glancing from one spot crosses no anchor gate", 0.0, 60.0)
-    keyframe_window_s: float = _f(2.0, "each keyframe request covers this long; renewed while judging", 0.1, 60.0)
+    keyframe_every_s: float = _d(5.0, "while judging, the memory makes a frame an anchor this often (KeyframeRequest): "
+                                      "a robot glancing from one spot crosses no anchor gate", 0.0, 300.0)
+    keyframe_window_s: float = _d(10.0, "each keyframe request covers this long; renewed while judging", 0.1, 300.0)
     closer_moves: int = _f(2, "with no view cell on the map, drive toward the candidate this many times before "
                               "deferring it (0: defer at once)", 0, 100)
     closer_min_gain: float = _f(1.0, "a closer cell lies this much nearer the candidate's box than the robot (m)",
@@ -148,7 +170,7 @@ class VerifySettings(_Section):
     near_view_distance: float = _f(0.6, "a frame whose camera stood this near the candidate's box and detected "
                                         "the target's label without placing it in 3D (no depth that near) counts "
                                         "as a fresh view (0: never)", 0.0, 5.0)
-    stall_s: float = _f(6.0, "a view cell the robot came no nearer to (by 0.25 m) for this long counts as failed",
+    stall_s: float = _d(30.0, "a view cell the robot came no nearer to (by 0.25 m) for this long counts as failed",
                         0.1, 600.0)
     stall_near: float = _f(0.35, "within this of its view cell the robot is there, glancing about (m)", 0.0, 5.0)
 
@@ -169,11 +191,11 @@ class ApproachSettings(_Section):
     facing_tolerance_deg: float = _f(35.0, "done only when facing the target within this", 1.0, 180.0)
     arrive_radius: float = _f(0.3, "done only this near the approach cell, when one was sent (m)", 0.0, 5.0)
     max_attempts: int = _f(4, "approach cells tried before the target is deferred", 1, 50)
-    timeout_s: float = _f(120.0, "no arrival in this long: the target is deferred", 0.1, MAX_DURATION_S)
-    defer_s: float = _f(30.0, "an unreachable target waits this long (clock s)", 0.0, MAX_DURATION_S)
+    timeout_s: float = _d(600.0, "no arrival in this long: the target is deferred", 0.1, MAX_DURATION_S)
+    defer_s: float = _d(150.0, "an unreachable target waits this long", 0.0, MAX_DURATION_S)
     creep: bool = _f(True, "settled beyond the distance: creep toward the object through floor the map does not "
                            "know before stopping")
-    creep_s: float = _f(3.0, "clock seconds a creep may take (blocked by clutter it would rock on)", 0.1, 600.0)
+    creep_s: float = _d(15.0, "a creep may take this long (blocked by clutter it would rock on)", 0.1, 3000.0)
     corner_radius: float = _f(0.3, "the robot's distance to the target is measured to its box with the corners rounded "
                               "by this (m, at most half the shorter side): most objects leave their box's corners "
                               "empty, so off a corner the object lies farther than the box (0: the box)", 0.0, 5.0)
@@ -185,7 +207,7 @@ class ApproachSettings(_Section):
                                       "noise", 0.0, 0.5)
     straight_within: float = _f(0.5, "this little beyond the distance, step straight in toward the box when the "
                                      "way and the view from the ring are clear (0: always a ring cell)", 0.0, 5.0)
-    stall_s: float = _f(6.0, "an approach cell the robot came no nearer to (by 0.25 m) for this long counts as "
+    stall_s: float = _d(30.0, "an approach cell the robot came no nearer to (by 0.25 m) for this long counts as "
                              "failed", 0.1, 600.0)
     min_ring: float = _f(0.2, "no ring for an approach cell lies nearer the footprint than this (m)", 0.0, 5.0)
     second_margin: float = _f(0.1, "a second ring lies at most this far inside the distance (m)", 0.0, 5.0)
@@ -206,7 +228,7 @@ class ReturnSettings(_Section):
     """ReturnToStart: going back to the pose where the mission started."""
 
     tolerance: float = _f(0.5, "back at the start within this (m)", 0.05, 5.0)
-    timeout_s: float = _f(300.0, "not back in this long: the behaviour fails", 0.1, MAX_DURATION_S)
+    timeout_s: float = _d(1500.0, "not back in this long: the behaviour fails", 0.1, MAX_DURATION_S)
 
 
 class DecisionsConfig(BaseModel):
@@ -221,6 +243,20 @@ class DecisionsConfig(BaseModel):
     approach: ApproachSettings = Field(default_factory=ApproachSettings)
     return_home: ReturnSettings = Field(default_factory=ReturnSettings)
 
+    def in_clock(self, scale: float) -> DecisionsConfig:
+        """This configuration with each duration in robot time (``robot_time_fields``) times
+        ``scale``, the mission clock's seconds per second of robot time (1 on a robot; on the
+        simulator's clocks, where one driver tick carries a whole discrete action,
+        ``hiconav.mission.stepped_time_scale``)."""
+        if scale == 1.0:
+            return self
+        sections = {}
+        for name in type(self).model_fields:
+            section = getattr(self, name)
+            fields = robot_time_fields(type(section))
+            sections[name] = section.model_copy(update={k: getattr(section, k) * scale for k in fields})
+        return self.model_copy(update=sections)
 
-__all__ = ["ApproachSettings", "DecisionsConfig", "ExploreSettings", "ParseSettings", "ReturnSettings",
-           "TargetSettings", "VerifySettings"]
+
+__all__ = ["ROBOT_TIME", "ApproachSettings", "DecisionsConfig", "ExploreSettings", "ParseSettings", "ReturnSettings",
+           "TargetSettings", "VerifySettings", "robot_time_fields"]

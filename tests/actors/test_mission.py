@@ -153,6 +153,18 @@ def test_eval_runner_entry_point_returns_an_episode_record(shared_data, embedder
     assert 0.0 < record.extra["shortest_to_success"] < record.geodesic_distance
 
 
+def test_the_mission_takes_its_decisions_durations_in_robot_time(house, episodes, embedder):
+    """On the simulator a driver tick carries a whole discrete action (0.5 s of a robot's time), so
+    the mission's clock takes the decisions' durations at a fifth; velocity control at the
+    driver's rate moves the robot for a tick's time (one to one)."""
+    parts = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder)
+    assert parts.mission.time_scale == pytest.approx(0.2)
+    assert parts.mission.decisions.explore.max_idle_s == pytest.approx(15.0)  # 75 s of robot time
+    moving = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder,
+                           overrides={"mission.control_mode": "velocity", "decisions.explore.max_idle_s": 30.0})
+    assert moving.mission.time_scale == 1.0 and moving.mission.decisions.explore.max_idle_s == 30.0
+
+
 def test_stepped_offline_reasoning_takes_no_measured_wall_time(house, episodes, embedder):
     """Same seed, same metrics needs virtual delays that do not depend on the machine's load: the
     offline reasoner's measured wall time must not become its stepped latency; every call takes

@@ -7,13 +7,16 @@ import math
 import numpy as np
 import pytest
 
-from hiconav.decisions.config import ExploreSettings
+from hiconav.decisions.config import DecisionsConfig, ExploreSettings
 from hiconav.decisions.frontiers import (ExploreLedger, FrontierFollower, PlanView, facing_yaw, look_goal,
                                          near_any, pick_frontier, pick_squeeze, push_goal, settle_reached)
 from hiconav.types import Frontier, Pose2D
 
-S = ExploreSettings()
-NO_START = ExploreSettings(start_look_turns=0)
+# the clocks below are the simulator's stepped clock, where a second of clock is five of robot time
+# (one 0.1 s driver tick carries a 0.5 s discrete action): the settings' durations on that clock
+STEPPED = 0.2
+S = DecisionsConfig(explore=ExploreSettings()).in_clock(STEPPED).explore
+NO_START = DecisionsConfig(explore=ExploreSettings(start_look_turns=0)).in_clock(STEPPED).explore
 
 
 def _frontier(fid: int, viewpoint: tuple[float, float], centroid: tuple[float, float]) -> Frontier:

@@ -38,10 +38,13 @@ def _write(tmp_path: Path, text: str) -> Path:
 
 # the tests look at one decision at a time: no look-around at the start unless a test asks for it
 NO_START_LOOK = DecisionsConfig(explore=ExploreSettings(start_look_turns=0))
+# the clocks here are the simulator's stepped clock, where a second of clock is five of robot time
+# (one 0.1 s driver tick carries a 0.5 s discrete action), as the mission actor puts the settings
+STEPPED = 0.2
 
 
 def _ctx(clock: Clock, **kw) -> MissionContext:
-    kw.setdefault("decisions", NO_START_LOOK)
+    kw["decisions"] = kw.get("decisions", NO_START_LOOK).in_clock(STEPPED)
     ctx = MissionContext(instruction="find the bed", clock=clock, **kw)
     ctx.task = TaskSpec("find the bed", ("bed",))
     ctx.world = world(Pose2D(2.0, 2.0, 0.0))

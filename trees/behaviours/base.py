@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import Any
 
 import py_trees
+from hiconav.decisions.config import robot_time_fields
 from hiconav.trees.builder import BlackboardRef
 from hiconav.trees.context import MissionContext
 from hiconav.trees.errors import BlackboardError, TreeError
@@ -77,7 +78,7 @@ class MissionBehaviour(py_trees.behaviour.Behaviour):
             return getattr(getattr(self.context.decisions, self.SETTINGS), key)
         value = self._params[key]
         if not isinstance(value, BlackboardRef):
-            return value
+            return self._on_clock(key, value)
         where = self._origin.get(key, "?")
         file, _, line = where.rpartition(":")
         if self.bb is None or not self.bb.exists(value.key):
@@ -88,7 +89,17 @@ class MissionBehaviour(py_trees.behaviour.Behaviour):
         if problem is not None:
             raise BlackboardError(f"{type(self).__name__}.{key} from blackboard key {value.key!r}: {problem}",
                                   file=file or None, line=int(line) if line.isdigit() else None, field=key)
-        return got
+        return self._on_clock(key, got)
+
+    def _on_clock(self, key: str, value: Any) -> Any:
+        """A duration of this node's settings section that the tree sets (robot time) on the
+        mission's clock (``MissionContext.time_scale``); any other value as it is."""
+        if self.SETTINGS is None or self.ctx is None or self.ctx.time_scale == 1.0:
+            return value
+        section = type(getattr(self.ctx.decisions, self.SETTINGS))
+        if key in robot_time_fields(section) and isinstance(value, (int, float)) and not isinstance(value, bool):
+            return value * self.ctx.time_scale
+        return value
 
     @property
     def settings(self) -> Any:
