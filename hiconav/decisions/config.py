@@ -21,6 +21,7 @@ This module holds data only.
 
 from __future__ import annotations
 
+import functools
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -42,6 +43,7 @@ def _d(default: float, reason: str, ge: float | None = None, le: float | None = 
     return _f(default, f"{reason} (s of robot time)", ge, le, json_schema_extra=ROBOT_TIME)
 
 
+@functools.lru_cache(maxsize=None)
 def robot_time_fields(section: type[BaseModel]) -> frozenset[str]:
     """The fields of a settings section that are durations in robot time."""
     return frozenset(name for name, f in section.model_fields.items() if f.json_schema_extra == ROBOT_TIME)
