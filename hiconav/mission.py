@@ -245,6 +245,10 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
         vlm_latency = model if vlm_latency is None else vlm_latency
         parse_latency = model if parse_latency is None else parse_latency
     rates = cfg.rates
+    # durations stated in robot time (decisions.*, reasoning.marginal_patience_s) on the mission's
+    # clock: one to one on a robot; on the simulator (either clock) a driver tick carries a whole
+    # discrete action
+    time_scale = 1.0 if robot is not None else stepped_time_scale(rates, cfg.control_mode)
     nav_cfg = area_config(NavigatorConfig, overrides, "planning")
     driver = DriverNode(sim, start, rate_hz=rates.driver, max_steps=sim_cfg.max_steps,
                         velocity_dt=1.0 / rates.control, lockstep=robot is not None,
@@ -257,7 +261,7 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
                               similarity=similarity, k=r_cfg.k,
                               rate_hz=rates.reasoning, stepped=stepped, latency_s=vlm_latency,
                               parse_latency_s=parse_latency, sync=cfg.sync_reasoning,
-                              marginal_patience_s=r_cfg.marginal_patience_s)
+                              marginal_patience_s=r_cfg.marginal_patience_s * time_scale)
     exploration = ExplorationNode(tracker, planner, rate_hz=rates.exploration, similarity=similarity)
     control = ControlNode(Navigator(nav_cfg), rate_hz=rates.control, mode=cfg.control_mode,
                           velocity_dt=1.0 / rates.control, hold_while_reasoning=cfg.sync_reasoning)
@@ -267,9 +271,7 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
                           requalify_observations=cfg.requalify_observations,
                           remap_area_m2=cfg.remap_area_m2,
                           decisions=area_config(DecisionsConfig, overrides, "decisions"),  # type: ignore[arg-type]
-                          # the decisions' durations are robot time: one to one on a robot; on the
-                          # simulator (either clock) a driver tick carries a whole discrete action
-                          time_scale=1.0 if robot is not None else stepped_time_scale(rates, cfg.control_mode),
+                          time_scale=time_scale,
                           record_tree=record is not None or spawn)
     nodes = [driver, perception, memory, reasoning, exploration, control, mission]
     for path, kwargs in cfg.extra_actors.items():

@@ -94,9 +94,11 @@ class ReasoningConfig(BaseModel):
     k: int = Field(5, ge=1, le=16)  # anchors (images) per subgraph request
     max_objects_per_anchor: int = Field(40, ge=1)
     confirm_confidence: float = Field(0.5, ge=0, le=1)  # a hypothesis at or above confirms
-    # clock s a described instance whose relations hold only within the boxes' noise margin waits
-    # for a clearer one before it is offered (``unresolved.due_marginal``; 0: until explored out)
-    marginal_patience_s: float = Field(10.0, ge=0, le=3600)
+    # seconds of robot time (0.5 s per discrete action; the simulator's clock takes them at a fifth,
+    # as ``decisions.*`` durations) a described instance whose relations hold only within the
+    # boxes' noise margin waits for a clearer one before it is offered (``unresolved.due_marginal``;
+    # 0: until explored out)
+    marginal_patience_s: float = Field(50.0, ge=0, le=18000)
     default_vlm_confidence: float = Field(0.7, ge=0, le=1)  # when the reply gives none
     max_latency_s: float | None = Field(None, gt=0, le=MAX_DURATION_S)  # replies slower than this are "late"
     max_attempts_per_subgraph: int = Field(2, ge=1)  # transient failures (timeouts, 5xx) retried

@@ -11,7 +11,8 @@ hypothesis when the mission reports the search explored out (``ExploredOut``), a
 verifies it (re-detection) like any other before it stops.
 
 A relation that holds only within the memory boxes' noise margin ("marginal") does not confirm an
-instance either: the search goes on for ``reasoning.marginal_patience_s`` clock seconds, and the
+instance either: the search goes on for ``reasoning.marginal_patience_s`` (robot time, on the
+mission's clock), and the
 best marginal instance is offered then if no clearer one was confirmed (``due_marginal``).
 
 Order: verdict "holds" (gated out by confidence or observations) before "marginal" before

@@ -187,3 +187,13 @@ def test_stepped_offline_reasoning_takes_no_measured_wall_time(house, episodes, 
     configured = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder,
                                overrides={"mission.vlm_latency_s": 2.0})
     assert configured.reasoning.latency_s == 2.0
+
+
+def test_the_reasoning_layer_waits_for_a_clearer_instance_in_robot_time(house, episodes, embedder):
+    """reasoning.marginal_patience_s is robot time, as the decisions' durations: 50 s of it is 10
+    seconds of the simulator's clock, where a 0.1 s tick carries a 0.5 s action."""
+    parts = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder)
+    assert parts.reasoning.marginal_patience_s == pytest.approx(10.0)
+    moving = build_mission(house, episodes[0].start, episodes[0].instruction, seed=0, embedder=embedder,
+                           overrides={"mission.control_mode": "velocity"})
+    assert moving.reasoning.marginal_patience_s == pytest.approx(50.0)
