@@ -182,6 +182,10 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
         raise ConfigError("a live robot runs on the real-time clock: the stepped (virtual) clock cannot "
                           "pause a vehicle between actor ticks; use --clock real", field="mission.clock")
     sim = robot if robot is not None else Simulator(house, sim_cfg, seed=seed)
+    # durations stated in robot time (reasoning latency, decisions.*, reasoning.marginal_patience_s)
+    # on the mission's clock: one to one on a robot; on the simulator (either clock) a driver tick
+    # carries a whole discrete action
+    time_scale = 1.0 if robot is not None else stepped_time_scale(cfg.rates, cfg.control_mode)
 
     # perception -------------------------------------------------------------------------------
     from hiconav.perception.config import PerceptionConfig
@@ -240,15 +244,11 @@ def build_mission(house: Any, start: Pose2D, instruction: str, *, seed: int = 0,
         # The model is in robot time: a 2 s call lasts as long as 4 discrete actions of a robot at
         # 0.5 m/s, whatever the stepped clock's tick (``mission.latency_time: clock`` takes it
         # in clock seconds instead, 20 actions at the default 10 Hz)
-        scale = stepped_time_scale(cfg.rates, cfg.control_mode) if cfg.latency_time == "robot" else 1.0
+        scale = time_scale if cfg.latency_time == "robot" else 1.0
         model = LatencyModel(r_cfg.latency_s, r_cfg.latency_jitter_s, seed, scale)
         vlm_latency = model if vlm_latency is None else vlm_latency
         parse_latency = model if parse_latency is None else parse_latency
     rates = cfg.rates
-    # durations stated in robot time (decisions.*, reasoning.marginal_patience_s) on the mission's
-    # clock: one to one on a robot; on the simulator (either clock) a driver tick carries a whole
-    # discrete action
-    time_scale = 1.0 if robot is not None else stepped_time_scale(rates, cfg.control_mode)
     nav_cfg = area_config(NavigatorConfig, overrides, "planning")
     driver = DriverNode(sim, start, rate_hz=rates.driver, max_steps=sim_cfg.max_steps,
                         velocity_dt=1.0 / rates.control, lockstep=robot is not None,
