@@ -148,6 +148,9 @@ class VerifySettings(_Section):
                                      "support it (m)", 0.0, 2.0)
     defer_s: float = _d(150.0, "a deferred candidate waits this long", 0.0, MAX_DURATION_S)
     max_deferrals: int = _f(2, "deferrals after which a candidate is rejected for good", 1, 100)
+    flip_reads: int = _f(2, "a candidate whose node's vote flips to a look-alike while the robot judges it is judged "
+                            "on, and deferred once this many fresh views read it so and none as a target (0: "
+                            "deferred at the flip)", 0, 1000)
     reposition_after: int = _f(4, "frames that could not show the candidate before trying another view cell",
                                1, 1000)
     view_cells: int = _f(3, "view cells tried before the candidate is deferred as hidden", 1, 100)

@@ -203,16 +203,47 @@ def deferred(reason: str, requalify: bool = False, remap: bool = False) -> Verdi
     return Verdict("deferred", reason, requalify, remap)
 
 
-def label_verdict(task_targets: Iterable[str] | None, label: str, source: str) -> Verdict | None:
+def label_verdict(task_targets: Iterable[str] | None, label: str, source: str, judging: bool = False
+                  ) -> Verdict | None:
     """Deferred (requalify) when a candidate taken for its label (``source`` "memory-label") now
-    carries a ``label`` that is not a target; else None.
+    carries a ``label`` that is not a target, unless frames of it are being judged
+    (``judging``); else None.
 
     Deferred, not rejected: a node's label is a vote over its observations and flips back and
     forth between confusable labels, so a real object read as a look-alike for a while comes
-    back."""
+    back. While the robot stands judging it, the fresh frames are that vote's next ballots: a
+    node observed twice, once read as a look-alike (a toilet as a sink, a plant as a vase), flips
+    on one frame, and the frames the robot came for settle it (``evidence_verdict`` confirms only
+    what most fresh views read as a target, and defers what they read otherwise)."""
+    if judging:
+        return None
     if task_targets is not None and label not in task_targets and source == "memory-label":
         return deferred(f"label is now {label!r}", requalify=True)
     return None
+
+
+def judged_on_as_chosen(task_targets: Iterable[str] | None, label: str, source: str) -> bool:
+    """Whether a candidate taken for its label (``source`` "memory-label") whose node's vote now
+    reads a ``label`` that is not a target, and whose verification judges on (``label_verdict``
+    while judging), is judged as the label it was chosen for: the frames are judged against the
+    task's targets, not against the look-alike the vote flipped to."""
+    return task_targets is not None and label not in task_targets and source == "memory-label"
+
+
+def flipped_verdict(settings: VerifySettings, tally: Tally, label: str) -> Verdict | None:
+    """For a candidate judged on after its node's vote flipped to ``label``, a look-alike
+    (``judged_on_as_chosen``): deferred (requalify) once ``flip_reads`` fresh views (``tally``)
+    read it as something other than a target and none as a target; else None (judge on).
+
+    The vote flips both ways: a real target read once as a look-alike comes back in the next
+    frames, and a look-alike first read as the target keeps reading as what it is; two such
+    frames are enough to leave it, not the ``max_view_frames`` a target-labelled node gets."""
+    if settings.flip_reads <= 0 or tally.target_reads > 0:
+        return None
+    others = tally.fresh - tally.target_reads
+    if others < settings.flip_reads:
+        return None
+    return deferred(f"label is now {label!r}, as {others} fresh views read it", requalify=True)
 
 
 def withdrawn(source: str, object_id: int, taken_back: Iterable[int]) -> bool:
@@ -300,5 +331,5 @@ def restart_unseen(tally: Tally) -> Tally:
 
 
 __all__ = ["Tally", "Verdict", "camera_gap", "confirmed_node", "deferred", "detected_too_near", "evidence_verdict", "for_good",
-           "frames_since", "judge_frames", "label_verdict", "read_labels", "recent_close", "restart_unseen", "same_object", "support_confidence",
+           "flipped_verdict", "frames_since", "judge_frames", "judged_on_as_chosen", "label_verdict", "read_labels", "recent_close", "restart_unseen", "same_object", "support_confidence",
            "support_ids", "support_observations", "target_labels", "timeout_verdict"]

@@ -26,9 +26,10 @@ import numpy as np
 
 from hiconav.decisions.cells import camera_of, furniture_boxes, wall_heights
 from hiconav.decisions.config import VerifySettings
-from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, deferred, evidence_verdict, for_good,
-                                            frames_since, judge_frames, recent_close, restart_unseen, same_object,
-                                            support_ids, target_labels, timeout_verdict)
+from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, deferred, evidence_verdict, flipped_verdict,
+                                            for_good, frames_since, judge_frames, judged_on_as_chosen, label_verdict,
+                                            recent_close, restart_unseen, same_object, support_ids, target_labels,
+                                            timeout_verdict)
 from hiconav.decisions.geometry import facing
 from hiconav.decisions.viewing import (ViewMove, blockers, close_distance, fallback_cell, nearer_candidate, next_view_move,
                                       sight, stall_matters, views_from_here)
@@ -113,11 +114,26 @@ class Verification:
         self.glances = self.closer_moves = self.unknown_moves = 0
         self.closing = False
         self.start_stamp: float | None = None  # sensor time of the newest frame at the first judge
+        self.flipped_to: str | None = None  # the look-alike the node's vote reads, judged on (``read_label``)
 
     @property
     def judging(self) -> bool:
         """Frames are judged: the robot is close, or a frame showed the candidate."""
         return self.close or bool(self.tally.in_view)
+
+    def read_label(self, settings: VerifySettings, task_targets: Iterable[str] | None, current: Any,
+                   chosen: str) -> tuple[Verdict | None, Any]:
+        """The verdict of the label the candidate's node reads now (``current``: the candidate as
+        the memory holds it, chosen as ``chosen``), and the candidate to judge: a node whose vote
+        flipped to a look-alike is deferred (``confirmation.label_verdict``), unless frames of it
+        are being judged (``judging``, with ``flip_reads`` set): then it is judged on as the label
+        it was chosen for, and ``judge`` defers it once ``flip_reads`` fresh views read it as the
+        look-alike and none as a target (``confirmation.flipped_verdict``)."""
+        source, label = getattr(current, "source", None), str(current.label)
+        verdict = label_verdict(task_targets, label, source, self.judging and settings.flip_reads > 0)
+        judged_on = verdict is None and judged_on_as_chosen(task_targets, label, source)
+        self.flipped_to = label if judged_on else None
+        return verdict, (replace(current, label=chosen) if judged_on else current)
 
     def judge(self, settings: VerifySettings, gap: float, ring: float, memory: Any, grid: Any, cand: Any,
               task_targets: Iterable[str] | None, label: str, described: bool = False) -> Judgement | None:
@@ -160,6 +176,8 @@ class Verification:
                                       targets=targets, near=settings.near_view_distance)
         verdict = evidence_verdict(settings, self.tally, label=label, n_obs=cand.n_obs, objects=objects,
                                    support=support)
+        if verdict is None and self.flipped_to is not None:
+            verdict = flipped_verdict(settings, self.tally, self.flipped_to)
         if verdict is None or verdict.outcome != "confirmed":
             return None if verdict is None else Judgement(verdict)
         found = confirmed_node(self.tally, cand.object_id)
@@ -235,7 +253,10 @@ def evidence_inputs(settings: VerifySettings, memory: Any, task_targets: Iterabl
     (``viewing.blockers``: neither those nor its own node)."""
     objects = memory.objects
     targets = target_labels(task_targets, cand.label)
-    support = support_ids(objects, targets, cand.box_min, cand.box_max, settings.support_margin)
+    # the candidate's own node supports it whatever its vote reads now: a vote flipped to a
+    # look-alike while the robot judges it is settled by the labels the fresh views read
+    support = support_ids(objects, targets, cand.box_min, cand.box_max, settings.support_margin) | {
+        int(cand.object_id)}
     return targets, support, blockers(objects, cand.box_min, cand.box_max, support | {int(cand.object_id)}, settings)
 
 

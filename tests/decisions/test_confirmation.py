@@ -171,6 +171,24 @@ def test_a_label_candidate_whose_label_flipped_is_deferred_to_requalify():
     assert conf.label_verdict(None, "sofa", "memory-label") is None
 
 
+def test_a_flipped_label_is_no_verdict_while_the_robot_judges_the_candidate():
+    # a toilet observed twice, once read as a sink: the frames the robot stands there for settle it
+    assert conf.label_verdict(["toilet"], "sink", "memory-label", judging=True) is None
+    assert conf.label_verdict(["toilet"], "sink", "memory-label", judging=False) is not None
+    assert conf.judged_on_as_chosen(["toilet"], "sink", "memory-label")
+    assert not conf.judged_on_as_chosen(["toilet"], "toilet", "memory-label")
+    assert not conf.judged_on_as_chosen(["toilet"], "sink", "hypothesis")
+
+
+def test_a_flipped_candidate_the_fresh_views_read_as_the_look_alike_is_deferred_after_two():
+    assert conf.flipped_verdict(S, conf.Tally(in_view=3, fresh=1, target_reads=0), "sink") is None  # one read
+    left = conf.flipped_verdict(S, conf.Tally(in_view=3, fresh=2, target_reads=0), "sink")
+    assert left is not None and left.outcome == "deferred" and left.requalify and "'sink'" in left.reason
+    # one frame read it as the target: the vote may come back, judge on (evidence_verdict decides)
+    assert conf.flipped_verdict(S, conf.Tally(in_view=4, fresh=3, target_reads=1), "sink") is None
+    assert conf.flipped_verdict(VerifySettings(flip_reads=0), conf.Tally(fresh=5), "sink") is None
+
+
 def test_no_verdict_before_the_timeout_defers():
     assert conf.timeout_verdict(S, S.timeout_s) is None
     assert conf.timeout_verdict(S, S.timeout_s + 0.1) == conf.deferred("no fresh views before the timeout")

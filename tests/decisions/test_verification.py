@@ -291,6 +291,32 @@ def test_a_candidate_takes_the_memory_nodes_current_fields():
     assert np.array_equal(lo, LO) and np.array_equal(hi, HI)
 
 
+def test_a_flipped_vote_defers_a_candidate_unless_frames_of_it_are_judged_then_judged_as_chosen():
+    flipped = Cand(1, "sofa", CENTRE, LO, HI)  # a bed whose node's vote now reads "sofa"
+    v = verif.Verification(0.0)
+    verdict, cand = v.read_label(S, ["bed"], flipped, "bed")
+    assert verdict is not None and verdict.requalify and cand is flipped and v.flipped_to is None
+    v.close = True  # the robot stands judging it
+    verdict, cand = v.read_label(S, ["bed"], flipped, "bed")
+    assert verdict is None and cand.label == "bed" and v.flipped_to == "sofa"
+    # two fresh views that read it as the sofa it now is: deferred
+    sofa = [Anchor(10 + k, camera_pose_from_base(Pose2D(3.5, 5.0, 0.0), 0.4), (1,), ("sofa",)) for k in range(3)]
+    memory = Memory([node(1, "sofa", 5, 5)], sofa[:1])
+    assert v.judge(S, 1.0, RING, memory, None, cand, ["bed"], "bed") is None  # the newest anchor starts the count
+    judged = v.judge(S, 1.0, RING, Memory(memory.objects, sofa), None, cand, ["bed"], "bed")
+    assert judged is not None and judged.verdict.requalify and "label is now 'sofa'" in judged.verdict.reason
+    v = verif.Verification(0.0)
+    v.close = True
+    assert v.read_label(S.model_copy(update={"flip_reads": 0}), ["bed"], flipped, "bed")[0] is not None
+
+
+def test_the_candidates_own_node_supports_it_whatever_its_vote_reads_now():
+    # a bed read once as a sofa flipped the node's vote: frames that observe the node are still its views
+    memory = Memory([node(1, "sofa", 5, 5), node(3, "sofa", 3.0, 5.0)])
+    targets, support, _ = verif.evidence_inputs(S, memory, ["bed"], BED)
+    assert targets == {"bed"} and support == {1}
+
+
 def test_nothing_hides_a_candidate_but_other_objects_off_its_footprint():
     memory = Memory([node(1, "bed", 5, 5), node(2, "bed", 5.6, 5.0), node(3, "sofa", 3.0, 5.0)])
     targets, support, hiding = verif.evidence_inputs(S, memory, ["bed"], BED)

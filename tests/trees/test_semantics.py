@@ -984,6 +984,31 @@ def test_verify_switches_between_two_candidates_a_few_times_at_most(tmp_path):
     assert ids[:3] == [5, 3, 5] and set(ids[3:]) == {5}
 
 
+def test_verify_judges_on_a_candidate_whose_label_flipped_while_it_looks_and_leaves_a_look_alike(tmp_path):
+    """A toilet observed twice, once read as a sink, flips its node's vote while the robot stands
+    judging it: the fresh frames settle the vote, so the robot judges on; two frames that read it
+    as the look-alike and none as the target defer it. With ``flip_reads: 0``, deferred at the flip."""
+    def flipped(leaf: str):
+        ctx = _ctx(Clock())
+        pose = Pose2D(3.6, 5.0, 0.0)  # 0.9 m from the bed's box: frames are judged
+        ctx.world = world(pose, [obj(3, "bed", 5.0, 5.0)], anchors=[anchor(1, pose)])
+        tree = _confirmed_then(tmp_path, ctx, leaf)
+        assert tree.tick() == S.RUNNING
+        ctx.world = world(pose, [obj(3, "sofa", 5.0, 5.0)], anchors=[anchor(1, pose)])
+        return ctx, tree, tree.tick()
+
+    ctx, tree, status = flipped("VerifyTarget: {glance_deg: 0.0}")
+    assert status == S.RUNNING and not ctx.rejections
+    pose = Pose2D(3.6, 5.0, 0.0)
+    for k in (2, 3):  # two fresh views, both read as a sofa
+        ctx.world = world(pose, [obj(3, "sofa", 5.0, 5.0)], anchors=[anchor(i, pose, (3,)) for i in range(1, k + 1)])
+        status = tree.tick()
+    assert status == S.FAILURE and "label is now 'sofa'" in ctx.rejections[-1][1]
+    assert ctx.excluded(3) and 3 not in ctx.rejected  # deferred, not rejected for good
+    ctx, _, status = flipped("VerifyTarget: {flip_reads: 0}")
+    assert status == S.FAILURE and "label is now 'sofa'" in ctx.rejections[-1][1]
+
+
 def test_verify_defers_a_candidate_whose_label_flipped_and_takes_it_back_later(tmp_path):
     """A node's label is a vote: a real fridge read as 'cabinet' for a while came back as a
     fridge, but a permanent rejection had already made the robot explore the house out."""

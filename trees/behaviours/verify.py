@@ -115,7 +115,8 @@ class VerifyTarget(_GoToObject):
         if (switched := self._switch(obj, cand)) is not None:
             return switched
         current = Candidate(cand.object_id, *verif.node_fields(obj), cand.source)
-        if (flipped := conf.label_verdict(self._targets(), obj.label, cand.source)) is not None:
+        flipped, current = self._v.read_label(self.settings, self._targets(), current, cand.label)
+        if flipped is not None:
             return self._reject(flipped)
         gap, ring = ctx.distance_to_box(current.box_min, current.box_max), self._ring(current)
         judged = self._v.judge(self.settings, gap, ring, ctx.memory, ctx.grid, current, self._targets(), cand.label,
