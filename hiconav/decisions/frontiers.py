@@ -188,6 +188,21 @@ def look_goal(pose: Pose2D) -> FrontierGoal:
     return FrontierGoal("look", pose.x, pose.y, wrap_angle(pose.yaw + math.pi / 2), LOOK_TOLERANCE_M)
 
 
+def start_look_step(state: str | None, pose: Pose2D | None, looks: int, s: ExploreSettings
+                    ) -> tuple[int, FrontierGoal | None, bool]:
+    """The start look as a step of its own (``LookAround``): with the quarter turn in flight in
+    navigation ``state`` (None: none sent) and ``looks`` quarter turns done, the quarter turns
+    done now, the next one to send (None: one is in flight, or no pose yet) and whether the
+    look is done (``start_look_turns``; Explore skips the look then, as it counts the same
+    turns)."""
+    looks += int(state in _ENDED)
+    if looks >= s.start_look_turns:
+        return looks, None, True
+    if (state is None or state in _ENDED) and pose is not None:
+        return looks, look_goal(pose), False
+    return looks, None, False
+
+
 def settle_reached(reached: list[tuple[np.ndarray, float]], plan: PlanView | None, spent: list[Spot],
                    s: ExploreSettings, now: float | None = None,
                    idle: bool = False) -> tuple[list[tuple[np.ndarray, float]], list[Spot]]:
@@ -489,4 +504,4 @@ class FrontierFollower:
 
 
 __all__ = ["ExploreLedger", "ExploreStep", "FrontierFollower", "FrontierGoal", "PlanView", "facing_yaw",
-           "look_goal", "near_any", "pick_frontier", "pick_squeeze", "push_goal", "settle_reached"]
+           "look_goal", "near_any", "pick_frontier", "pick_squeeze", "push_goal", "settle_reached", "start_look_step"]

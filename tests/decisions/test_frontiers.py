@@ -9,7 +9,8 @@ import pytest
 
 from hiconav.decisions.config import DecisionsConfig, ExploreSettings
 from hiconav.decisions.frontiers import (ExploreLedger, FrontierFollower, PlanView, facing_yaw, look_goal,
-                                         near_any, pick_frontier, pick_squeeze, push_goal, settle_reached)
+                                         near_any, pick_frontier, pick_squeeze, push_goal, settle_reached,
+                                         start_look_step)
 from hiconav.types import Frontier, Pose2D
 
 # the clocks below are the simulator's stepped clock, where a second of clock is five of robot time
@@ -269,3 +270,16 @@ def test_explored_out_with_nothing_deferred_or_to_ask_the_last_resort_comes_once
     off = ExploreSettings(start_look_turns=0, last_resort=False)
     assert f.step(None, Pose2D(0.0, 0.0, 0.0), 300.0, _plan(), ledger, {}, off).status == "failure"
     assert f.step(None, Pose2D(0.0, 0.0, 0.0), 300.0, _plan(), ledger, {}, NO_START).last_resort
+
+
+def test_the_start_look_as_a_step_of_its_own_counts_each_ended_quarter_turn():
+    s = ExploreSettings(start_look_turns=2)
+    pose = Pose2D(1.0, 2.0, 0.0)
+    looks, goal, done = start_look_step(None, pose, 0, s)
+    assert (looks, done) == (0, False) and goal.kind == "look" and goal.yaw == pytest.approx(math.pi / 2)
+    assert start_look_step("following", pose, 0, s) == (0, None, False)  # in flight: nothing new
+    looks, goal, done = start_look_step("reached", Pose2D(1.0, 2.0, math.pi / 2), 0, s)
+    assert (looks, done) == (1, False) and math.cos(goal.yaw) == pytest.approx(-1.0)
+    assert start_look_step("failed", pose, 1, s) == (2, None, True)  # a turn that failed counts as made
+    assert start_look_step(None, None, 0, s) == (0, None, False)  # no pose yet
+    assert start_look_step(None, pose, 0, ExploreSettings(start_look_turns=0)) == (0, None, True)

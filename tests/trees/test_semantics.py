@@ -690,6 +690,31 @@ def test_explore_looks_around_the_start_once_per_mission_before_any_frontier(tmp
     assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].goal.kind == "frontier"
 
 
+def test_look_around_turns_before_a_candidate_is_taken_and_explore_does_not_look_again(tmp_path):
+    """A candidate seen in the first frame waits for the start look: the look shows the room all
+    round first (the nearest candidate may stand behind the robot, and the map holds no view cell
+    yet). The quarter turns are the mission's, so Explore goes to frontiers straight after."""
+    ctx = _ctx(Clock(), decisions=DecisionsConfig(explore=ExploreSettings(start_look_turns=2)))
+    ctx.world = world(Pose2D(2.0, 2.0, 0.0), [obj(3, "bed", 8.0, 5.0)])
+    ctx.plan = plan((8.0, 8.0))
+    tree = MissionTree(_write(tmp_path, "root:\n  Sequence:\n    memory: true\n    children:\n"
+                                        "      - LookAround: {}\n      - Selector:\n          children:\n"
+                                        "            - TargetConfirmed: {}\n            - Explore: {}\n"), ctx)
+    yaws = []
+    for _ in range(2):
+        assert tree.tick() == S.RUNNING
+        goal = [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1]
+        assert goal.goal.kind == "look" and goal.source == "LookAround"
+        yaws.append(goal.goal.yaw)
+        assert tree.tick() == S.RUNNING  # the turn in flight: no new goal
+        assert [m for m in ctx.outbox if isinstance(m, GoalMsg)][-1].seq == goal.seq
+        ctx.nav = NavStatus(goal.seq, "reached", 0.0)
+        ctx.world = world(Pose2D(2.0, 2.0, goal.goal.yaw), [obj(3, "bed", 8.0, 5.0)])
+    assert [math.cos(y) for y in yaws] == pytest.approx([0.0, -1.0], abs=1e-9)
+    tree.tick()  # the look done: the candidate is taken
+    assert ctx.start_looks == 2 and tree.root.children[1].status == S.SUCCESS
+
+
 def test_approach_cell_prefers_the_front_of_an_objects_middle_over_its_near_end():
     """A painting 1 m long on a wall at x = 5: the plain nearest cell lies off its lower end (a
     grazing view, not a ground-truth view point); with the centre weight the cell faces its middle."""

@@ -9,7 +9,8 @@ pose, the state of the goal in flight, the mission's record of exploration), ask
 from __future__ import annotations
 
 from hiconav.decisions import linger
-from hiconav.decisions.frontiers import ExploreLedger, FrontierFollower, FrontierGoal, PlanView, look_goal
+from hiconav.decisions.frontiers import (ExploreLedger, FrontierFollower, FrontierGoal, PlanView, look_goal,
+                                        start_look_step)
 from hiconav.trees.behaviours.base import MissionBehaviour, Status
 from hiconav.trees.registry import register_behaviour
 from hiconav.types import Goal
@@ -109,6 +110,36 @@ class Explore(MissionBehaviour):
         if getattr(self, "_seq", None) is not None and self.ctx is not None:
             self.ctx.send_goal(None)
             self._seq = None
+
+
+@register_behaviour()
+class LookAround(MissionBehaviour):
+    """Turn in place a quarter turn at a time until the mission's start look is done
+    (``explore.start_look_turns``; ``frontiers.start_look_step``), then SUCCESS. The turns count
+    in ``MissionContext.start_looks``, which Explore reads: it does not look again.
+
+    Before the search, it shows the start room all round before a candidate is chosen: a
+    candidate seen in the first frames would be judged against a map with no view cell of it
+    yet, and the nearest one may stand behind the robot."""
+
+    SETTINGS = "explore"
+
+    def initialise(self) -> None:
+        self._seq: int | None = None
+
+    def update(self) -> Status:
+        ctx = self.context
+        state = None if self._seq is None else ctx.nav_state(self._seq)
+        ctx.start_looks, goal, done = start_look_step(state, ctx.pose, ctx.start_looks, self.settings)
+        if state in ("reached", "failed"):
+            self._seq = None
+        if done:
+            self.feedback_message = "looked around the start"
+            return Status.SUCCESS
+        if goal is not None:
+            self._seq = ctx.send_goal(_goal(goal))
+        self.feedback_message = f"looking around the start ({ctx.start_looks}/{self.param('start_look_turns')})"
+        return Status.RUNNING
 
 
 def _goal(goal: FrontierGoal) -> Goal:
