@@ -137,11 +137,6 @@ class VerifySettings(_Section):
     max_view_frames: int = _f(8, "frames in view after which a rarely detected candidate is rejected", 1, 10000)
     unseen_view_frames: int = _f(4, "frames in view without a single detection after which a candidate observed "
                                     "at most unseen_max_observations times is rejected", 1, 10000)
-    misses_on_the_way: bool = _f(True, "frames on the way to a candidate observed at most unseen_max_observations "
-                                      "times, from no farther than where its verification began, that hold it in "
-                                      "view and miss it count toward unseen_view_frames (rejected for good)")
-    way_margin: float = _f(0.25, "a frame on the way counts from this much farther than the robot stood when the "
-                                 "verification began (m)", 0.0, 10.0)
     unseen_max_observations: int = _f(2, "candidates observed more often get the full max_view_frames", 0, 10000)
     min_confidence: float = _f(0.3, "a confirmed candidate scored below this is deferred", 0.0, 1.0)
     confident_observations: int = _f(10, "nodes observed this often pass min_confidence: detectors score small "

@@ -299,16 +299,6 @@ def evidence_verdict(settings: VerifySettings, tally: Tally, *, label: str, n_ob
     return None
 
 
-def way_verdict(settings: VerifySettings, tally: Tally) -> Verdict | None:
-    """Rejected for good when the frames on the way to a rarely observed candidate (``tally``:
-    ``Verification.misses_on_the_way``) held it in view ``unseen_view_frames`` times and none
-    detected it; else None. The test ``evidence_verdict`` makes of the close frames of such a
-    candidate (a real object is missed in 4 frames in a row about 1% of the time)."""
-    if tally.fresh == 0 and tally.in_view >= settings.unseen_view_frames:
-        return Verdict("rejected", f"detected in 0 of {tally.in_view} frames in view on the way")
-    return None
-
-
 def confirmed_node(tally: Tally, candidate_id: int) -> tuple[int, int] | None:
     """The supporting node (id, fresh views) that more fresh views observed than the candidate
     itself (the first of equals), or None: the candidate is the object found.
@@ -341,5 +331,5 @@ def restart_unseen(tally: Tally) -> Tally:
 
 
 __all__ = ["Tally", "Verdict", "camera_gap", "confirmed_node", "deferred", "detected_too_near", "evidence_verdict", "for_good",
-           "flipped_verdict", "frames_since", "judge_frames", "way_verdict", "judged_on_as_chosen", "label_verdict", "read_labels", "recent_close", "restart_unseen", "same_object", "support_confidence",
+           "flipped_verdict", "frames_since", "judge_frames", "judged_on_as_chosen", "label_verdict", "read_labels", "recent_close", "restart_unseen", "same_object", "support_confidence",
            "support_ids", "support_observations", "target_labels", "timeout_verdict"]

@@ -26,10 +26,10 @@ import numpy as np
 
 from hiconav.decisions.cells import camera_of, furniture_boxes, wall_heights
 from hiconav.decisions.config import VerifySettings
-from hiconav.decisions.confirmation import (Tally, Verdict, camera_gap, confirmed_node, deferred, evidence_verdict,
-                                            flipped_verdict, for_good, frames_since, judge_frames, judged_on_as_chosen,
-                                            label_verdict, recent_close, restart_unseen, same_object, support_ids,
-                                            target_labels, timeout_verdict, way_verdict)
+from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, deferred, evidence_verdict, flipped_verdict,
+                                            for_good, frames_since, judge_frames, judged_on_as_chosen, label_verdict,
+                                            recent_close, restart_unseen, same_object, support_ids, target_labels,
+                                            timeout_verdict)
 from hiconav.decisions.geometry import facing
 from hiconav.decisions.viewing import (ViewMove, blockers, close_distance, fallback_cell, nearer_candidate, next_view_move,
                                       sight, stall_matters, views_from_here)
@@ -39,8 +39,6 @@ from hiconav.types import Goal, wrap_angle
 CLOSER_TOLERANCE, UNKNOWN_TOLERANCE, GLANCE_TOLERANCE = 0.3, 0.2, 0.5
 #: the source of a candidate the reasoning layer put forward (``Candidate.source``)
 HYPOTHESIS = "hypothesis"
-#: the source of a candidate taken for its detector label alone
-LABEL = "memory-label"
 
 C = TypeVar("C")
 
@@ -117,9 +115,6 @@ class Verification:
         self.closing = False
         self.start_stamp: float | None = None  # sensor time of the newest frame at the first judge
         self.flipped_to: str | None = None  # the look-alike the node's vote reads, judged on (``read_label``)
-        self.start_gap: float | None = None  # the robot's distance to the box at the first judge (m)
-        self.way = Tally()  # frames judged on the way, before the robot is close (``misses_on_the_way``)
-        self.last_way_anchor: int | None = None
 
     @property
     def judging(self) -> bool:
@@ -147,10 +142,9 @@ class Verification:
         (``confirmation.judge_frames``, against the ``memory`` snapshot's objects and the map
         ``grid``) for the candidate ``cand`` (its current box and observations; read as ``label``
         when it was chosen), and give the verdict of the frames so far (``evidence_verdict``);
-        if not, that of the frames on the way (``misses_on_the_way``). None: judge on. A
-        confirmed candidate hands on to the supporting node the fresh views observed more often
-        (``confirmation.confirmed_node``); for a ``described`` instance only when that node is
-        the same object seen again (``confirmation.same_object``): the
+        None: judge on. A confirmed candidate hands on to the supporting node the fresh views
+        observed more often (``confirmation.confirmed_node``); for a ``described`` instance only
+        when that node is the same object seen again (``confirmation.same_object``): the
         reasoning layer chose the candidate by its relations, and a neighbour of the same label
         whose box touches it (chairs around a table) is another instance, not checked.
 
@@ -167,11 +161,9 @@ class Verification:
             # tick per action of 0.5 s): a window over frames is measured in the frames' own time,
             # from the newest frame the memory held when the verification began
             self.start_stamp = float(getattr(memory, "stamp", self.start))
-        if self.start_gap is None:
-            self.start_gap = float(gap)
         self.close = gap <= close_distance(settings, ring)
         if not self.close:
-            return self.misses_on_the_way(settings, memory, grid, cand, task_targets)
+            return None
         anchors, objects = tuple(getattr(memory, "anchors", ()) or ()), memory.objects
         earlier = None if settings.recent_view_s <= 0.0 or getattr(cand, "source", None) != HYPOTHESIS else partial(
             recent_close, since=self.start_stamp - settings.recent_view_s, box_min=cand.box_min,
@@ -197,35 +189,6 @@ class Verification:
             return Judgement(verdict, feedback=said)
         return Judgement(verdict, node, f"#{cand.object_id} confirmed by views of #{found[0]} ({found[1]} of them): "
                                         f"going to #{found[0]}", said)
-
-    def misses_on_the_way(self, settings: VerifySettings, memory: Any, grid: Any, cand: Any,
-                          task_targets: Iterable[str] | None) -> Judgement | None:
-        """On the way to a candidate taken for its label (``cand``, source "memory-label") and
-        observed at most ``unseen_max_observations`` times: the frames whose camera stood no
-        farther from its box than the robot when the verification began, with it in view
-        (``confirmation.judge_frames``), and that detected nothing on it, are misses; after
-        ``unseen_view_frames`` of them and no detection, it is rejected for good
-        (``confirmation.way_verdict``). None: drive on. A frame on the way that detects it
-        confirms nothing: the close frames do that.
-
-        The frame that made the candidate saw it from where the robot stood; a real object
-        shows as large or larger in every frame from as near, and is detected in nine of ten.
-        A spurious box is one frame's: every later frame toward it misses it, and driving on to
-        a view cell to glance at it spends the way there."""
-        if (not settings.misses_on_the_way or getattr(cand, "source", None) != LABEL
-                or int(cand.n_obs) > settings.unseen_max_observations):
-            return None
-        anchors = tuple(getattr(memory, "anchors", ()) or ())
-        frames, self.last_way_anchor = frames_since(anchors, self.last_way_anchor)
-        reach = (self.start_gap or 0.0) + settings.way_margin
-        frames = [a for a in frames if camera_gap(a, cand.box_min, cand.box_max) <= reach]
-        if frames:
-            _, support, hiding = evidence_inputs(settings, memory, task_targets, cand)
-            self.way = judge_frames(self.way, frames, objects=memory.objects, grid=grid, center=cand.center,
-                                    box_min=cand.box_min, box_max=cand.box_max, support=support, hiding=hiding,
-                                    targets=target_labels(task_targets, cand.label), near=0.0)
-        verdict = way_verdict(settings, self.way)
-        return None if verdict is None else Judgement(verdict)
 
     def next_move(self, settings: VerifySettings, *, elapsed: float, sent: bool, state: str, cell: np.ndarray | None,
                   mapped: bool, stalled: Callable[[], bool]) -> ViewMove:
@@ -369,6 +332,6 @@ def posting(settings: VerifySettings, verdict: Verdict, object_id: int, rejectio
     return Posting(for_good(settings, verdict.permanent, remap, count), verdict.requalify, remap)
 
 
-__all__ = ["CLOSER_TOLERANCE", "CellGoal", "GLANCE_TOLERANCE", "HYPOTHESIS", "Judgement", "LABEL", "Posting", "Switch", "UNKNOWN_TOLERANCE",
+__all__ = ["CLOSER_TOLERANCE", "CellGoal", "GLANCE_TOLERANCE", "HYPOTHESIS", "Judgement", "Posting", "Switch", "UNKNOWN_TOLERANCE",
            "Verification", "evidence_inputs", "hiding", "move_verdict", "nearer_switch", "node_fields",
            "posting", "sight_of", "view_feedback", "view_here"]

@@ -85,43 +85,6 @@ def test_frames_are_judged_only_within_the_close_distance_and_only_those_made_af
     assert v.judging
 
 
-def test_frames_on_the_way_that_miss_a_rarely_seen_candidate_reject_it_before_the_view_cell():
-    """A spurious box is one frame's: frames toward it from no farther than where its
-    verification began, holding it in view, miss it. Four such misses reject it for good on the
-    way; a frame from farther, one that detects it, or a candidate seen often do not."""
-    def toward(aid: int, x: float, seen: bool = False) -> Anchor:
-        return Anchor(aid, camera_pose_from_base(Pose2D(x, 5.0, 0.0), 0.4), (1,) if seen else (),
-                      ("bed",) if seen else ())
-
-    far = close_distance(S, RING) + 1.0
-    bed = [node(1, "bed", 5, 5)]
-    v = verif.Verification(0.0)
-    assert v.judge(S, 3.0, RING, Memory(bed, [toward(9, 1.5)]), None, BED, ["bed"], "bed") is None  # starts 3 m off
-    assert v.way.in_view == 0  # frames before the start are not the way's
-    misses = [toward(9, 1.5)] + [toward(10 + k, 1.6 + 0.1 * k) for k in range(4)]
-    judged = v.judge(S, far, RING, Memory(bed, misses), None, BED, ["bed"], "bed")
-    assert judged is not None and judged.verdict.permanent and "on the way" in judged.verdict.reason
-    assert v.way.in_view == 4 and not v.close
-    # from farther than the start (a camera 3.5 m off, beyond 3.0 + way_margin): not misses
-    v = verif.Verification(0.0)
-    v.judge(S, 3.0, RING, Memory(bed, [toward(9, 1.5)]), None, BED, ["bed"], "bed")
-    assert v.judge(S, far, RING, Memory(bed, [toward(10 + k, 1.0) for k in range(5)]), None, BED, ["bed"],
-                   "bed") is None and v.way.in_view == 0
-    # one frame on the way detects it: judged on at the view cell
-    v = verif.Verification(0.0)
-    v.judge(S, 3.0, RING, Memory(bed, [toward(9, 1.5)]), None, BED, ["bed"], "bed")
-    seen = [toward(10, 1.6, seen=True)] + [toward(11 + k, 1.7 + 0.1 * k) for k in range(4)]
-    assert v.judge(S, far, RING, Memory(bed, seen), None, BED, ["bed"], "bed") is None and v.way.fresh == 1
-    # observed three times (more than unseen_max_observations), or a hypothesis, or the rule off: no way tally
-    for cand, settings in ((Cand(1, "bed", CENTRE, LO, HI, n_obs=3), S),
-                           (Cand(1, "bed", CENTRE, LO, HI, source=verif.HYPOTHESIS), S),
-                           (BED, S.model_copy(update={"misses_on_the_way": False}))):
-        v = verif.Verification(0.0)
-        v.judge(settings, 3.0, RING, Memory(bed, [toward(9, 1.5)]), None, cand, ["bed"], "bed")
-        assert v.judge(settings, far, RING, Memory(bed, misses), None, cand, ["bed"], "bed") is None
-        assert v.way.in_view == 0
-
-
 def test_frames_taken_close_just_before_the_verification_of_a_hypothesis_began_count_with_recent_view_s():
     """A robot that drove up to a candidate the reasoning layer put forward saw it from as near as a
     view cell would stand: those frames confirm it at once, where without them it drove off to a
