@@ -215,24 +215,22 @@ def label_verdict(task_targets: Iterable[str] | None, label: str, source: str, j
     node observed twice, once read as a look-alike (a toilet as a sink, a plant as a vase), flips
     on one frame, and the frames the robot came for settle it (``evidence_verdict`` confirms only
     what most fresh views read as a target, and defers what they read otherwise)."""
-    if judging:
+    if judging or not label_flipped(task_targets, label, source):
         return None
-    if task_targets is not None and label not in task_targets and source == "memory-label":
-        return deferred(f"label is now {label!r}", requalify=True)
-    return None
+    return deferred(f"label is now {label!r}", requalify=True)
 
 
-def judged_on_as_chosen(task_targets: Iterable[str] | None, label: str, source: str) -> bool:
-    """Whether a candidate taken for its label (``source`` "memory-label") whose node's vote now
-    reads a ``label`` that is not a target, and whose verification judges on (``label_verdict``
-    while judging), is judged as the label it was chosen for: the frames are judged against the
-    task's targets, not against the look-alike the vote flipped to."""
+def label_flipped(task_targets: Iterable[str] | None, label: str, source: str) -> bool:
+    """Whether a candidate taken for its label (``source`` "memory-label") now carries a node
+    ``label`` that is not one of the ``task_targets``: its node's vote flipped to a look-alike.
+    ``label_verdict`` defers it; while judging, it is judged on as the label it was chosen for
+    (``Verification.read_label``)."""
     return task_targets is not None and label not in task_targets and source == "memory-label"
 
 
 def flipped_verdict(settings: VerifySettings, tally: Tally, label: str) -> Verdict | None:
     """For a candidate judged on after its node's vote flipped to ``label``, a look-alike
-    (``judged_on_as_chosen``): deferred (requalify) once ``flip_reads`` fresh views (``tally``)
+    (``label_flipped``, judged on): deferred (requalify) once ``flip_reads`` fresh views (``tally``)
     read it as something other than a target and none as a target; else None (judge on).
 
     The vote flips both ways: a real target read once as a look-alike comes back in the next
@@ -331,5 +329,5 @@ def restart_unseen(tally: Tally) -> Tally:
 
 
 __all__ = ["Tally", "Verdict", "camera_gap", "confirmed_node", "deferred", "detected_too_near", "evidence_verdict", "for_good",
-           "flipped_verdict", "frames_since", "judge_frames", "judged_on_as_chosen", "label_verdict", "read_labels", "recent_close", "restart_unseen", "same_object", "support_confidence",
+           "flipped_verdict", "frames_since", "judge_frames", "label_flipped", "label_verdict", "read_labels", "recent_close", "restart_unseen", "same_object", "support_confidence",
            "support_ids", "support_observations", "target_labels", "timeout_verdict"]

@@ -27,7 +27,7 @@ import numpy as np
 from hiconav.decisions.cells import camera_of, furniture_boxes, wall_heights
 from hiconav.decisions.config import VerifySettings
 from hiconav.decisions.confirmation import (Tally, Verdict, confirmed_node, deferred, evidence_verdict, flipped_verdict,
-                                            for_good, frames_since, judge_frames, judged_on_as_chosen, label_verdict,
+                                            for_good, frames_since, judge_frames, label_flipped, label_verdict,
                                             recent_close, restart_unseen, same_object, support_ids, target_labels,
                                             timeout_verdict)
 from hiconav.decisions.geometry import facing
@@ -131,7 +131,7 @@ class Verification:
         look-alike and none as a target (``confirmation.flipped_verdict``)."""
         source, label = getattr(current, "source", None), str(current.label)
         verdict = label_verdict(task_targets, label, source, self.judging and settings.flip_reads > 0)
-        judged_on = verdict is None and judged_on_as_chosen(task_targets, label, source)
+        judged_on = verdict is None and label_flipped(task_targets, label, source)
         self.flipped_to = label if judged_on else None
         return verdict, (replace(current, label=chosen) if judged_on else current)
 
@@ -249,15 +249,15 @@ def evidence_inputs(settings: VerifySettings, memory: Any, task_targets: Iterabl
                     cand: Any) -> tuple[set[str], set[int], tuple[np.ndarray, np.ndarray] | None]:
     """What the frames of the candidate ``cand`` are judged against, among the ``memory``
     snapshot's objects: the target labels (the task's and its own), the nodes that support it
-    (``confirmation.support_ids``, ``support_margin``) and the boxes that may hide it
-    (``viewing.blockers``: neither those nor its own node)."""
+    (its own and ``confirmation.support_ids``, ``support_margin``) and the boxes that may hide it
+    (``viewing.blockers``: none of those)."""
     objects = memory.objects
     targets = target_labels(task_targets, cand.label)
     # the candidate's own node supports it whatever its vote reads now: a vote flipped to a
     # look-alike while the robot judges it is settled by the labels the fresh views read
     support = support_ids(objects, targets, cand.box_min, cand.box_max, settings.support_margin) | {
         int(cand.object_id)}
-    return targets, support, blockers(objects, cand.box_min, cand.box_max, support | {int(cand.object_id)}, settings)
+    return targets, support, blockers(objects, cand.box_min, cand.box_max, support, settings)
 
 
 def hiding(settings: VerifySettings, memory: Any, task_targets: Iterable[str] | None,

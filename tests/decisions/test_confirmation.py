@@ -175,9 +175,9 @@ def test_a_flipped_label_is_no_verdict_while_the_robot_judges_the_candidate():
     # a toilet observed twice, once read as a sink: the frames the robot stands there for settle it
     assert conf.label_verdict(["toilet"], "sink", "memory-label", judging=True) is None
     assert conf.label_verdict(["toilet"], "sink", "memory-label", judging=False) is not None
-    assert conf.judged_on_as_chosen(["toilet"], "sink", "memory-label")
-    assert not conf.judged_on_as_chosen(["toilet"], "toilet", "memory-label")
-    assert not conf.judged_on_as_chosen(["toilet"], "sink", "hypothesis")
+    assert conf.label_flipped(["toilet"], "sink", "memory-label")
+    assert not conf.label_flipped(["toilet"], "toilet", "memory-label")
+    assert not conf.label_flipped(["toilet"], "sink", "hypothesis")
 
 
 def test_a_flipped_candidate_the_fresh_views_read_as_the_look_alike_is_deferred_after_two():
