@@ -30,6 +30,7 @@ import numpy as np
 
 from hiconav.decisions.config import ExploreSettings
 from hiconav.decisions.progress import StallClock
+from hiconav.decisions.viewing import DONE
 from hiconav.types import Pose2D, wrap_angle
 
 # a viewpoint this near its frontier's centroid has no direction to face: the goal leaves the
@@ -41,8 +42,6 @@ PUSH_HEADING_MIN_M = 0.1
 # a look is a turn in place at the robot's own position: any tolerance above the pose's drift
 # reaches it (m)
 LOOK_TOLERANCE_M = 0.5
-
-_ENDED = ("reached", "failed")
 
 Spot = tuple[float, float]
 
@@ -195,10 +194,10 @@ def start_look_step(state: str | None, pose: Pose2D | None, looks: int, s: Explo
     done now, the next one to send (None: one is in flight, or no pose yet) and whether the
     look is done (``start_look_turns``; Explore skips the look then, as it counts the same
     turns)."""
-    looks += int(state in _ENDED)
+    looks += int(state in DONE)
     if looks >= s.start_look_turns:
         return looks, None, True
-    if (state is None or state in _ENDED) and pose is not None:
+    if (state is None or state in DONE) and pose is not None:
         return looks, look_goal(pose), False
     return looks, None, False
 
@@ -367,19 +366,19 @@ class FrontierFollower:
         log: list[str] = []
         state = self._judge(state, pose, now, ledger, s, log)
         out = self._choose(state, pose, now, plan, ledger, deferred, s, log)
-        return replace(out, ended=state in _ENDED)
+        return replace(out, ended=state in DONE)
 
     def _judge(self, state: str | None, pose: Pose2D | None, now: float, ledger: ExploreLedger,
                s: ExploreSettings, log: list[str]) -> str | None:
         """The state of the goal in flight, "failed" when it is given up (a push past ``push_s``,
         a stall); an ended goal's frontier is visited, and remembered as reached or failed."""
         in_flight = state is not None
-        if self.push_at is not None and state not in _ENDED and now - self.push_at > s.push_s:
+        if self.push_at is not None and state not in DONE and now - self.push_at > s.push_s:
             state = "failed"  # a push blocked by what the map does not know: rocking on gains nothing
-        if self.frontier is not None and state not in _ENDED and self._stalled(pose, now, in_flight, s):
+        if self.frontier is not None and state not in DONE and self._stalled(pose, now, in_flight, s):
             log.append(f"frontier #{self.frontier}: no progress for {s.stall_s:.0f} s, skipped")
             state = "failed"
-        if state in _ENDED:
+        if state in DONE:
             self.push_at = None
             if self.frontier is not None:
                 self.visited.add(self.frontier)
@@ -395,10 +394,10 @@ class FrontierFollower:
                 log: list[str]) -> ExploreStep:
         """What to do with the goal in flight judged (``state``): look around at the start, keep
         a push or a squeeze going, go to the frontier picked, or what is left without one."""
-        in_flight = state is not None and state not in _ENDED
-        if self.frontier is not None and state not in _ENDED and self._nearer(pose, s.progress_m):
+        in_flight = state is not None and state not in DONE
+        if self.frontier is not None and state not in DONE and self._nearer(pose, s.progress_m):
             ledger.last_frontier_time = now  # nearer a frontier (a re-picked or squeezed one too)
-        if state in _ENDED and self.start_look:
+        if state in DONE and self.start_look:
             ledger.start_looks += 1
             self.start_look = False
         if ledger.start_looks < s.start_look_turns:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from hiconav.decisions import linger
 from hiconav.decisions.frontiers import (ExploreLedger, FrontierFollower, FrontierGoal, PlanView, look_goal,
                                         start_look_step)
+from hiconav.decisions.viewing import DONE
 from hiconav.trees.behaviours.base import MissionBehaviour, Status
 from hiconav.trees.registry import register_behaviour
 from hiconav.types import Goal
@@ -76,7 +77,7 @@ class Explore(MissionBehaviour):
         explore on afresh: True while turning."""
         ctx, s, pose = self.context, self.settings, self.context.pose
         if self._lingering is not None:
-            if ctx.nav_state(self._seq) not in ("reached", "failed"):
+            if ctx.nav_state(self._seq) not in DONE:
                 return True
             self._turns += 1
             if self._turns < s.linger_turns:
@@ -131,7 +132,7 @@ class LookAround(MissionBehaviour):
         ctx = self.context
         state = None if self._seq is None else ctx.nav_state(self._seq)
         ctx.start_looks, goal, done = start_look_step(state, ctx.pose, ctx.start_looks, self.settings)
-        if state in ("reached", "failed"):
+        if state in DONE:
             self._seq = None
         if done:
             self.feedback_message = "looked around the start"
