@@ -484,6 +484,14 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
     result = run_mission(house, episode, seed=seed, overrides=overrides, clock="stepped")
     m = result.metrics
     positions = result.trajectory[:, :2] if len(result.trajectory) else result.trajectory.reshape(0, 2)
+    semexp = None
+    if house.success_rule == "semexp":  # published Gibson tables' SPL, beside ours (docs/evaluation.md)
+        from hiconav.eval.summary import semexp_code_spl
+        from hiconav.sim import SimConfig
+
+        sim_cfg: Any = area_config(SimConfig, dict(overrides or {}), "sim")
+        semexp = semexp_code_spl(bool(m.success), float(m.shortest_to_success), float(sim_cfg.success_distance),
+                                 float(m.path_length))
     return EpisodeRecord(
         episode_id=spec.episode_id, house=spec.house, target=spec.target, seed=seed, success=bool(m.success),
         spl=float(m.spl), dts=float(m.dts) if math.isfinite(m.dts) else math.inf, steps=int(m.steps),
@@ -501,6 +509,7 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
                                           if e["kind"] == "verify" or (e["kind"] == "unresolved" and e["found"]))),
                "feedback": result.mission_feedback,
                "shortest_to_success": float(m.shortest_to_success),  # SPL's l (docs/evaluation.md)
+               "spl_semexp": semexp,  # SemExp's own code's SPL on its maps (Gibson), else None
                "turns": m.turns,  # of the steps, discrete turns in place (None: velocity control)
                # the actions per behaviour whose goal they served (None: velocity control)
                "actions_by_behaviour": result.actions_by_behaviour,

@@ -92,6 +92,13 @@ def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
                "rescores them); DTS is the mean geodesic distance to the success region at the end. "
                "Intervals: Wilson score for SR, a seeded percentile bootstrap for SPL; "
                "`python -m hiconav.eval.compare BEFORE AFTER` compares two runs episode by episode."), ""]
+    semexp = [f"{name} {_pct(g['spl_semexp_code'])}% over {g['spl_semexp_code_episodes']}"
+              for name, g in presets.items() if g.get("spl_semexp_code") is not None]
+    if semexp:
+        lines += [("On SemExp's maps (Gibson), SPL as SemExp's and L3MVN's own code computes it, for comparison "
+                   "with published tables only: " + "; ".join(semexp) + " episodes. Their shortest path adds the "
+                   "1.0 m success distance to the distance to the success region (docs/evaluation.md); "
+                   "the SPL above does not."), ""]
 
     ablations: dict[str, dict[str, Any]] = summary.get("ablations", {})
     lines += ["## Ablations", ""]

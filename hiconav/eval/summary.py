@@ -39,6 +39,17 @@ def spl_value(success: bool, shortest: float, actual: float) -> float:
     return 1.0 if denominator <= 0 else float(shortest / denominator)
 
 
+def semexp_code_spl(success: bool, shortest_to_success: float, success_distance: float, actual: float) -> float:
+    """SPL as SemExp's and L3MVN's ``objectgoal_env.py`` compute it for the Gibson maps:
+    ``min(S * starting_distance / path_length, 1)`` with ``starting_distance`` the fast-marching
+    distance from the start to the success region *plus* the success distance (their
+    ``object_boundary``). Published Gibson tables use it; our SPL (``spl_value``) keeps Habitat's
+    l^s, the distance to the region alone, and reads lower on the same episodes."""
+    if not success:
+        return 0.0
+    return min(1.0, (float(shortest_to_success) + float(success_distance)) / max(float(actual), 1e-5))
+
+
 def _mean(values: Sequence[float]) -> float | None:
     return float(sum(values) / len(values)) if values else None
 
@@ -144,6 +155,8 @@ def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
         by_target[target] = {"episodes": len(group),
                              "success_rate": _mean([float(r.success) for r in group]),
                              "spl": _mean([float(r.spl) for r in group])}
+    semexp = [float(r.extra["spl_semexp"]) for r in valid
+              if isinstance(r.extra, dict) and r.extra.get("spl_semexp") is not None]
     sr_ci = wilson_interval(sum(bool(r.success) for r in valid), len(valid))
     spl_ci = bootstrap_interval([float(r.spl) for r in valid])
     return {
@@ -153,6 +166,10 @@ def summarize_group(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
         "success_rate_ci95": list(sr_ci) if sr_ci else None,  # Wilson score interval
         "spl": _mean([float(r.spl) for r in valid]),
         "spl_ci95": list(spl_ci) if spl_ci else None,  # percentile bootstrap, seeded
+        # SemExp's own code's SPL (``semexp_code_spl``) over the episodes on SemExp-rule maps
+        # (Gibson): for comparison with published tables only, never the SPL above
+        "spl_semexp_code": _mean(semexp),
+        "spl_semexp_code_episodes": len(semexp),
         "dts": _mean(dts_known),
         "dts_unknown": len(valid) - len(dts_known),
         "failures": failures,

@@ -151,6 +151,7 @@ def test_eval_runner_entry_point_returns_an_episode_record(shared_data, embedder
     assert set(record.layer_frames) >= {"driver", "perception", "memory", "mission", "control"}
     # SPL's l: the way to the success region, shorter than the way to the sofa itself
     assert 0.0 < record.extra["shortest_to_success"] < record.geodesic_distance
+    assert record.extra["spl_semexp"] is None  # SemExp's own SPL only on its maps (Gibson)
 
 
 def test_the_mission_takes_its_decisions_durations_in_robot_time(house, episodes, embedder):

@@ -7,7 +7,7 @@ import math
 import pytest
 
 from hiconav.eval.records import EpisodeRecord
-from hiconav.eval.summary import spl_value, summarize
+from hiconav.eval.summary import semexp_code_spl, spl_value, summarize
 
 
 def rec(i: int, preset: str = "full", **kw) -> EpisodeRecord:
@@ -20,6 +20,25 @@ def test_spl_value_is_success_times_shortest_over_longer_path() -> None:
     assert spl_value(True, 4.0, 2.0) == pytest.approx(1.0)  # max(l_s, l_a) caps it at 1
     assert spl_value(False, 4.0, 4.0) == 0.0
     assert spl_value(True, 0.0, 0.0) == 1.0
+
+
+def test_semexp_code_spl_adds_the_success_distance_to_the_shortest_path() -> None:
+    """SemExp's objectgoal_env: min(S * (fmm distance to the region + object_boundary) / path, 1)."""
+    assert semexp_code_spl(True, 4.0, 1.0, 10.0) == pytest.approx(0.5)
+    assert spl_value(True, 4.0, 10.0) == pytest.approx(0.4)  # ours, Habitat's l^s, on the same episode
+    assert semexp_code_spl(True, 4.0, 1.0, 4.5) == 1.0  # capped
+    assert semexp_code_spl(False, 4.0, 1.0, 10.0) == 0.0
+
+
+def test_semexp_code_spl_is_summarised_apart_and_only_over_the_records_that_carry_it() -> None:
+    records = [rec(0, success=True, spl=0.4, extra={"spl_semexp": 0.5}),
+               rec(1, success=False, spl=0.0, extra={"spl_semexp": 0.0}),
+               rec(2, success=True, spl=1.0)]  # a ProcTHOR-rule house: no SemExp figure
+    s = summarize(records)
+    assert s["spl"] == pytest.approx(1.4 / 3)
+    assert s["spl_semexp_code"] == pytest.approx(0.25) and s["spl_semexp_code_episodes"] == 2
+    none = summarize([rec(0, success=True, spl=1.0)])
+    assert none["spl_semexp_code"] is None and none["spl_semexp_code_episodes"] == 0
 
 
 def test_sr_spl_dts_are_means_over_valid_episodes() -> None:

@@ -415,3 +415,20 @@ def test_generated_gibson_starts_lie_where_the_robot_can_drive_to_the_goal(share
     region[2, 6] = True
     assert np.array_equal(reaching_pieces(driving_pieces(lone), region), lone & (np.arange(9) >= 5))
     assert not reaching_pieces(driving_pieces(lone), np.zeros_like(lone)).any()
+
+
+def test_a_gibson_record_carries_semexps_own_spl_beside_ours(shared_data):
+    """On SemExp's maps a record also carries SPL as SemExp's code computes it (the success distance
+    added to the shortest path, as published Gibson tables use); ours keeps Habitat's l^s."""
+    from hiconav.eval.sources import EpisodeSpec
+    from hiconav.eval.summary import semexp_code_spl, spl_value
+    from hiconav.mission import run_episode
+
+    chair = EpisodeSpec("gibson:Merom/0/0", "gibson:Merom/0", "chair", (-8.795, 4.535, 2.2467), (0, 1, 2), 1.875,
+                        "find the chair")
+    record = run_episode(chair, {"sim.max_steps": 60}, 506636410)
+    assert record.success
+    shortest = record.extra["shortest_to_success"]
+    assert record.spl == pytest.approx(spl_value(True, shortest, record.path_length))
+    assert record.extra["spl_semexp"] == pytest.approx(semexp_code_spl(True, shortest, 1.0, record.path_length))
+    assert record.extra["spl_semexp"] > record.spl
