@@ -484,18 +484,17 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
     result = run_mission(house, episode, seed=seed, overrides=overrides, clock="stepped")
     m = result.metrics
     positions = result.trajectory[:, :2] if len(result.trajectory) else result.trajectory.reshape(0, 2)
+    sim_cfg: Any = area_config(_sim_config_cls(), dict(overrides or {}), "sim")
     semexp = None
     if house.success_rule == "semexp":  # published Gibson tables' SPL, beside ours (docs/evaluation.md)
         from hiconav.eval.summary import semexp_code_spl
-        from hiconav.sim import SimConfig
 
-        sim_cfg: Any = area_config(SimConfig, dict(overrides or {}), "sim")
         semexp = semexp_code_spl(bool(m.success), float(m.shortest_to_success), float(sim_cfg.success_distance),
                                  float(m.path_length))
     return EpisodeRecord(
         episode_id=spec.episode_id, house=spec.house, target=spec.target, seed=seed, success=bool(m.success),
         spl=float(m.spl), dts=float(m.dts) if math.isfinite(m.dts) else math.inf, steps=int(m.steps),
-        max_steps=parts_max_steps(overrides),
+        max_steps=int(sim_cfg.max_steps),
         path_length=float(m.path_length), geodesic_distance=float(spec.geodesic_distance),
         termination=result.termination, last_progress_step=last_progress_step(positions),
         task_time_s=float(result.clock_s), wall_time_s=time.perf_counter() - wall0,
@@ -518,12 +517,6 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
                    "to_success_m": None if m.view_to_success is None or not math.isfinite(m.view_to_success)
                    else float(m.view_to_success)},
                "dropped": {k: dict(v.dropped) for k, v in result.stats.items() if v.dropped}})
-
-
-def parts_max_steps(overrides: dict[str, Any] | None) -> int:
-    from hiconav.sim import SimConfig
-
-    return int(area_config(SimConfig, dict(overrides or {}), "sim").max_steps)  # type: ignore[attr-defined]
 
 
 # ------------------------------------------------------------------------------------- hiconav run
