@@ -81,7 +81,7 @@ class ControlNode(Node):
 
     def _command(self, now: float, **kw: Any) -> None:
         self._cmd_seq += 1
-        self.emit("driver", CommandMsg(self._cmd_seq, now, **kw))
+        self.emit("driver", CommandMsg(self._cmd_seq, now, source=self._source or "", **kw))
 
     def tick(self, now: float) -> None:
         if self._stop is not None:

@@ -68,6 +68,7 @@ class DriverNode(Node):
         self.pauses: list[dict[str, Any]] = []  # {"start", "end" (None while paused), "reason"}
         self.ended: EpisodeEnded | None = None
         self.trajectory: list[tuple[float, float, float]] = []
+        self.sources: list[str] = []  # per executed command (trajectory[i] -> [i + 1]): CommandMsg.source
         self.actions: list[str] = []
         self.last_command: VelocityCommand | DiscreteAction | None = None
         self._pending_frame: Any = None
@@ -79,9 +80,12 @@ class DriverNode(Node):
         self._pending_frame = self._frame(lambda: self.sim.reset(self.start_pose))
         self._record()
 
-    def _record(self) -> None:
+    def _record(self, source: str | None = None) -> None:
+        """Append the pose to the trajectory; after a command (``source``: its behaviour) that too."""
         p = self.sim.pose
         self.trajectory.append((float(p.x), float(p.y), float(p.yaw)))
+        if source is not None:
+            self.sources.append(source)
 
     def _end(self, reason: str, now: float) -> None:
         if self.ended is None:
@@ -154,14 +158,14 @@ class DriverNode(Node):
             self.last_command = cmd.action
             self.actions.append(cmd.action.value)
             frame = self._frame(lambda: self.sim.step(cmd.action))
-            self._record()
+            self._record(cmd.source)
             if cmd.action == DiscreteAction.STOP:
                 self._end("stop", now)
                 return
         elif cmd.velocity is not None:
             self.last_command = cmd.velocity
             frame = self._frame(lambda: self.sim.step_velocity(cmd.velocity, self.velocity_dt))
-            self._record()
+            self._record(cmd.source)
         else:
             return
         if self.sim.steps >= self.max_steps:

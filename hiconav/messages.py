@@ -180,12 +180,14 @@ class StopRequest:
 
 @dataclass(frozen=True)
 class CommandMsg:
-    """Control -> Driver: one discrete action or a body velocity (latest-wins)."""
+    """Control -> Driver: one discrete action or a body velocity (latest-wins); ``source``: the
+    behaviour whose goal it serves ("" when none is named)."""
 
     seq: int
     stamp: float
     action: DiscreteAction | None = None
     velocity: VelocityCommand | None = None
+    source: str = ""
 
 
 @dataclass(frozen=True)

@@ -321,6 +321,9 @@ class MissionResult:
     # discrete actions per behaviour whose goal they served ({"Explore": {"turns", "forward",
     # "other"}}; ``ControlNode.actions``); None under velocity control, where steps are control ticks
     actions_by_behaviour: dict[str, dict[str, int]] | None = None
+    # the path beyond the shortest by the behaviour each step served (``metrics.excess_by_source``;
+    # the simulator's ground truth), None on a robot
+    excess_path: dict[str, Any] | None = None
 
     def summary(self) -> dict[str, Any]:
         m = self.metrics
@@ -398,6 +401,8 @@ def run_mission(house: Any, episode: Any, *, seed: int = 0, overrides: dict[str,
     control = parts.control
     if control is not None and getattr(control, "mode", "") == "discrete":
         result.actions_by_behaviour = {k: dict(v) for k, v in control.actions.items()}
+    if robot is None:
+        result.excess_path = _excess_path(parts.driver, tracker)
     if robot is not None:
         result.pauses = list(getattr(parts.driver, "pauses", []))
         result.driver = str(getattr(robot, "name", "robot"))
@@ -406,6 +411,21 @@ def run_mission(house: Any, episode: Any, *, seed: int = 0, overrides: dict[str,
     except Exception:  # closing the renderer must not hide the result
         pass
     return result
+
+
+def _excess_path(driver: Any, tracker: Any) -> dict[str, Any] | None:
+    """``metrics.excess_by_source`` over the driver's trajectory and the behaviours its commands
+    served, measured by the episode's ``tracker`` (None when the two do not line up)."""
+    import numpy as np
+
+    from hiconav.sim.metrics import excess_by_source
+
+    sources = list(getattr(driver, "sources", ()))
+    xy = np.asarray(driver.path, dtype=np.float64)[:, :2]
+    if len(xy) != len(sources) + 1:
+        return None
+    success_distance = float(tracker.sim.config.success_distance)
+    return excess_by_source(xy, sources, lambda p: tracker.goal.to_success(p, success_distance))
 
 
 def _sim_config_cls() -> type[BaseModel]:
@@ -512,6 +532,8 @@ def run_episode(spec: Any, overrides: dict[str, Any] | None = None, seed: int = 
                "turns": m.turns,  # of the steps, discrete turns in place (None: velocity control)
                # the actions per behaviour whose goal they served (None: velocity control)
                "actions_by_behaviour": result.actions_by_behaviour,
+               # the path beyond the shortest by behaviour (ground truth; None: not measured)
+               "excess_path": result.excess_path,
                "goal_in_view": None if m.steps_to_view is None else {
                    "steps": int(m.steps_to_view), "path_m": float(m.path_to_view),
                    "to_success_m": None if m.view_to_success is None or not math.isfinite(m.view_to_success)

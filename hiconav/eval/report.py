@@ -173,6 +173,13 @@ def render_markdown(records: Sequence[EpisodeRecord], summary: dict[str, Any],
                    "truth, not what the detector reported); after it, the path driven against the shortest "
                    "path from that spot to the success region. Before the view is exploration; after it, "
                    "detection, verification and the approach."), ""]
+        excess = [(name, g["path"]["excess"]) for name, g in presets.items()
+                  if (g.get("path") or {}).get("excess", {}).get("successes_measured")]
+        lines += [f"Path beyond SPL's shortest paths, {name}: {_num(e['excess_m'], 0)} m over "
+                  f"{e['successes_measured']} successes, by the behaviour whose goal each step served: " + ", ".join(
+                      f"{b} {_num(v['m'], 0)} m ({_pct(v['share'])}%)" for b, v in e["by_behaviour"].items())
+                  + f"; {_num(e['inside_m'], 1)} m of it inside the success region (ground truth: a step's length "
+                    "less its progress toward the region)." for name, e in excess]
         acts = [(name, p) for name, p in ((n, g.get("actions", {})) for n, g in presets.items())
                 if p.get("episodes_measured")]
         lines += [f"Turns in place, {name}: {p['turns']} of {p['actions']} actions ({_pct(p['turn_share'])}%) over "

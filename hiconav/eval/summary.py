@@ -83,7 +83,26 @@ def path_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
         "after_view_shortest_m": float(sum(goal_view(r)["to_success_m"] for r in known)),
         "failures_measured": len(fails),
         "failures_never_in_view": sum(1 for r in fails if r.extra["goal_in_view"] is None),
+        "excess": excess_split(records),
     }
+
+
+def excess_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:
+    """The path the successes drove beyond SPL's shortest paths, by the behaviour whose goal each
+    step served (``extra["excess_path"]``, ``metrics.excess_by_source``: ground truth), most
+    first, with each behaviour's share; ``inside_m``: of it, driven inside the success region.
+    Records without the field (older runs, robots) are left out (``successes_measured``)."""
+    wins = [r for r in records if r.success and isinstance(r.extra, dict)
+            and isinstance(r.extra.get("excess_path"), dict)]
+    by: dict[str, float] = {}
+    for r in wins:
+        for name, metres in (r.extra["excess_path"].get("by_behaviour") or {}).items():
+            by[str(name)] = by.get(str(name), 0.0) + float(metres)
+    whole = sum(by.values())
+    return {"successes_measured": len(wins), "excess_m": whole,
+            "inside_m": float(sum(float(r.extra["excess_path"].get("inside_m", 0.0)) for r in wins)),
+            "by_behaviour": {name: {"m": m, "share": m / whole if whole > 0 else None}
+                             for name, m in sorted(by.items(), key=lambda kv: (-kv[1], kv[0]))}}
 
 
 def action_split(records: Sequence[EpisodeRecord]) -> dict[str, Any]:

@@ -38,6 +38,36 @@ def dts(final_distance: float, success_distance: float = 1.0) -> float:
     return max(0.0, float(final_distance) - success_distance)
 
 
+def excess_by_source(xy: Any, sources: Any, to_success: Any) -> dict[str, Any]:
+    """Where a path goes beyond the shortest: for each step from ``xy[i]`` to ``xy[i + 1]`` ((N + 1, 2)
+    world m, the robot after each command) served by ``sources[i]`` (N behaviour names), the
+    length driven less the progress made toward the success region, ``to_success(xy)`` (geodesic m,
+    0 inside it). Returns ``{"by_behaviour": {name: m}, "inside_m": m driven with the robot inside
+    the region both before and after the step (counted in its behaviour too), "unmeasured_m": m of
+    steps with an end off the measurable floor (non-finite distance, in no behaviour)}``.
+
+    Over a successful episode the excesses sum to the path less SPL's shortest path (the region
+    reached, from the start): a turn in place costs none, a step straight toward the region none, a
+    step along a detour its length and one back away from it twice that."""
+    pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    names = [str(n) for n in sources]
+    if len(pts) != len(names) + 1:
+        raise ValueError(f"excess_by_source: {len(pts)} positions for {len(names)} steps (need one more)")
+    d = np.array([float(to_success(p)) for p in pts], dtype=np.float64)
+    steps = np.hypot(*(pts[1:] - pts[:-1]).T) if len(names) else np.zeros(0)
+    by: dict[str, float] = {}
+    inside = unmeasured = 0.0
+    for i, name in enumerate(names):
+        if not (np.isfinite(d[i]) and np.isfinite(d[i + 1])):
+            unmeasured += float(steps[i])
+            continue
+        by[name] = by.get(name, 0.0) + float(steps[i] - (d[i] - d[i + 1]))
+        if d[i] <= 0.0 and d[i + 1] <= 0.0:
+            inside += float(steps[i])
+    return {"by_behaviour": {k: round(v, 3) for k, v in by.items()}, "inside_m": round(inside, 3),
+            "unmeasured_m": round(unmeasured, 3)}
+
+
 @dataclass(frozen=True)
 class EpisodeMetrics:
     """The record of one finished episode."""

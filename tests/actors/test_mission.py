@@ -152,6 +152,12 @@ def test_eval_runner_entry_point_returns_an_episode_record(shared_data, embedder
     # SPL's l: the way to the success region, shorter than the way to the sofa itself
     assert 0.0 < record.extra["shortest_to_success"] < record.geodesic_distance
     assert record.extra["spl_semexp"] is None  # SemExp's own SPL only on its maps (Gibson)
+    # each executed action is charged to the behaviour it served: the excesses add up to the path
+    # less the progress made toward the success region
+    excess = record.extra["excess_path"]
+    progress = record.extra["shortest_to_success"] - max(record.dts, 0.0)
+    assert sum(excess["by_behaviour"].values()) >= -1e-6 and excess["unmeasured_m"] == 0.0
+    assert sum(excess["by_behaviour"].values()) <= record.path_length - progress + 0.3
 
 
 def test_the_mission_takes_its_decisions_durations_in_robot_time(house, episodes, embedder):

@@ -82,5 +82,11 @@ def test_the_report_says_where_the_path_went_when_records_carry_the_goal_in_view
         for r in counted]
     assert ("Actions by the behaviour whose goal they served, full: Explore 180 (90.0%, 60 turns), "
             "VerifyTarget 20 (10.0%, 18 turns).") in render_markdown(tallied, summarize(tallied))
+    assert "Path beyond SPL's shortest paths" not in render_markdown(tallied, summarize(tallied))  # not measured
+    measured = [EpisodeRecord(**{**r.__dict__, "extra": {**r.extra, "excess_path": {
+        "by_behaviour": {"Explore": 3.0, "Approach": 1.0}, "inside_m": 0.5, "unmeasured_m": 0.0}}}) for r in records]
+    assert ("Path beyond SPL's shortest paths, full: 4 m over 1 successes, by the behaviour whose goal each step "
+            "served: Explore 3 m (75.0%), Approach 1 m (25.0%); 0.5 m of it inside the success region"
+            ) in render_markdown(measured, summarize(measured))
     older = [rec(2, True, 3.0)]  # records written before the field existed: no such section
     assert "## Where the path goes" not in render_markdown(older, summarize(older))

@@ -127,3 +127,19 @@ def test_actions_split_by_the_behaviour_whose_goal_they_served() -> None:
     assert list(by) == ["Explore", "Approach"]  # most actions first
     assert by["Explore"] == {"actions": 30, "turns": 16, "share": 0.75}
     assert by["Approach"] == {"actions": 10, "turns": 2, "share": 0.25}
+
+
+def test_excess_split_sums_the_successes_path_beyond_the_shortest_by_behaviour() -> None:
+    ex = lambda by, inside: {"excess_path": {"by_behaviour": by, "inside_m": inside, "unmeasured_m": 0.0}}  # noqa: E731
+    records = [
+        rec(0, success=True, spl=0.5, path_length=10.0, extra=ex({"Explore": 4.0, "Approach": 1.0}, 0.5)),
+        rec(1, success=True, spl=0.8, path_length=5.0, extra=ex({"VerifyTarget": 3.0, "Explore": 2.0}, 0.25)),
+        rec(2, success=False, spl=0.0, path_length=40.0, extra=ex({"Explore": 30.0}, 0.0)),  # a failure: left out
+        rec(3, success=True, spl=1.0, path_length=3.0),  # an older record: no such field
+    ]
+    e = summarize(records)["path"]["excess"]
+    assert e["successes_measured"] == 2 and e["excess_m"] == pytest.approx(10.0) and e["inside_m"] == pytest.approx(0.75)
+    assert list(e["by_behaviour"]) == ["Explore", "VerifyTarget", "Approach"]  # most first
+    assert e["by_behaviour"]["Explore"] == {"m": pytest.approx(6.0), "share": pytest.approx(0.6)}
+    assert summarize([records[3]])["path"]["excess"] == {"successes_measured": 0, "excess_m": 0.0, "inside_m": 0.0,
+                                                          "by_behaviour": {}}

@@ -432,3 +432,8 @@ def test_a_gibson_record_carries_semexps_own_spl_beside_ours(shared_data):
     assert record.spl == pytest.approx(spl_value(True, shortest, record.path_length))
     assert record.extra["spl_semexp"] == pytest.approx(semexp_code_spl(True, shortest, 1.0, record.path_length))
     assert record.extra["spl_semexp"] > record.spl
+    # the path beyond the shortest, split by the behaviours the steps served, adds up to the path less l
+    excess = record.extra["excess_path"]
+    assert excess["unmeasured_m"] == 0.0 and set(excess["by_behaviour"]) <= {"LookAround", "VerifyTarget", "Approach",
+                                                                             "Explore"}
+    assert sum(excess["by_behaviour"].values()) == pytest.approx(record.path_length - shortest, abs=1e-2)

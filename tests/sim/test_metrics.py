@@ -80,3 +80,25 @@ def test_tracker_scores_a_simulated_episode():
     tracker = EpisodeTracker(sim, ep)
     sim.step_velocity(VelocityCommand(0.3, 0.5), 0.1)
     assert sim.turns == 0 and tracker.finish().turns is None
+
+
+def test_excess_by_source_charges_each_step_its_length_less_its_progress_to_the_region():
+    import math
+
+    from hiconav.sim.metrics import excess_by_source
+
+    # the success region is x >= 3 (distance 3 - x): straight in costs nothing, a detour its length,
+    # a step back twice it, a turn in place nothing, and steps inside the region all their length
+    xy = [(0, 0), (1, 0), (1, 0), (1, 1), (1, 0), (0, 0), (1, 0), (2, 0), (3, 0), (4, 0)]
+    sources = ["Explore", "Explore", "Explore", "Explore", "VerifyTarget", "VerifyTarget", "Approach",
+               "Approach", "Approach"]
+    out = excess_by_source(xy, sources, lambda p: max(0.0, 3.0 - float(p[0])))
+    assert out["by_behaviour"] == {"Explore": 2.0, "VerifyTarget": 2.0, "Approach": 1.0}
+    assert out["inside_m"] == 1.0 and out["unmeasured_m"] == 0.0
+    path = sum(math.dist(a, b) for a, b in zip(xy, xy[1:]))
+    assert sum(out["by_behaviour"].values()) == pytest.approx(path - 3.0)  # the path less SPL's l
+    off = excess_by_source([(0, 0), (5, 5), (1, 0)], ["Explore", "Explore"],
+                           lambda p: math.inf if p[1] > 1 else 3.0 - float(p[0]))
+    assert off["by_behaviour"] == {} and off["unmeasured_m"] == pytest.approx(math.hypot(5, 5) + math.hypot(4, 5), abs=1e-3)
+    with pytest.raises(ValueError, match="one more"):
+        excess_by_source([(0, 0)], ["Explore"], lambda p: 0.0)
