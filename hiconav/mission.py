@@ -403,7 +403,7 @@ def run_mission(house: Any, episode: Any, *, seed: int = 0, overrides: dict[str,
         result.actions_by_behaviour = {k: dict(v) for k, v in control.actions.items()}
     if robot is None:
         result.excess_path = _excess_path(parts.driver, tracker)
-    if robot is not None:
+    else:
         result.pauses = list(getattr(parts.driver, "pauses", []))
         result.driver = str(getattr(robot, "name", "robot"))
     try:

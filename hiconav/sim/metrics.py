@@ -40,7 +40,7 @@ def dts(final_distance: float, success_distance: float = 1.0) -> float:
 
 def excess_by_source(xy: Any, sources: Any, to_success: Any) -> dict[str, Any]:
     """Where a path goes beyond the shortest: for each step from ``xy[i]`` to ``xy[i + 1]`` ((N + 1, 2)
-    world m, the robot after each command) served by ``sources[i]`` (N behaviour names), the
+    world m, the robot after each command) served by ``sources[i]`` (N behaviour names, "" read "unnamed"), the
     length driven less the progress made toward the success region, ``to_success(xy)`` (geodesic m,
     0 inside it). Returns ``{"by_behaviour": {name: m}, "inside_m": m driven with the robot inside
     the region both before and after the step (counted in its behaviour too), "unmeasured_m": m of
@@ -50,7 +50,7 @@ def excess_by_source(xy: Any, sources: Any, to_success: Any) -> dict[str, Any]:
     reached, from the start): a turn in place costs none, a step straight toward the region none, a
     step along a detour its length and one back away from it twice that."""
     pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-    names = [str(n) for n in sources]
+    names = [str(n) or "unnamed" for n in sources]  # a command no behaviour named, as ControlNode.actions
     if len(pts) != len(names) + 1:
         raise ValueError(f"excess_by_source: {len(pts)} positions for {len(names)} steps (need one more)")
     d = np.array([float(to_success(p)) for p in pts], dtype=np.float64)

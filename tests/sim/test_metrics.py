@@ -100,5 +100,6 @@ def test_excess_by_source_charges_each_step_its_length_less_its_progress_to_the_
     off = excess_by_source([(0, 0), (5, 5), (1, 0)], ["Explore", "Explore"],
                            lambda p: math.inf if p[1] > 1 else 3.0 - float(p[0]))
     assert off["by_behaviour"] == {} and off["unmeasured_m"] == pytest.approx(math.hypot(5, 5) + math.hypot(4, 5), abs=1e-3)
+    assert excess_by_source([(0, 0), (0, 1)], [""], lambda p: 3.0)["by_behaviour"] == {"unnamed": 1.0}
     with pytest.raises(ValueError, match="one more"):
         excess_by_source([(0, 0)], ["Explore"], lambda p: 0.0)
