@@ -402,7 +402,7 @@ def run_mission(house: Any, episode: Any, *, seed: int = 0, overrides: dict[str,
     if control is not None and getattr(control, "mode", "") == "discrete":
         result.actions_by_behaviour = {k: dict(v) for k, v in control.actions.items()}
     if robot is None:
-        result.excess_path = _excess_path(parts.driver, tracker)
+        result.excess_path = _excess_path(result.trajectory, getattr(parts.driver, "sources", ()), tracker)
     else:
         result.pauses = list(getattr(parts.driver, "pauses", []))
         result.driver = str(getattr(robot, "name", "robot"))
@@ -413,15 +413,14 @@ def run_mission(house: Any, episode: Any, *, seed: int = 0, overrides: dict[str,
     return result
 
 
-def _excess_path(driver: Any, tracker: Any) -> dict[str, Any] | None:
-    """``metrics.excess_by_source`` over the driver's trajectory and the behaviours its commands
-    served, measured by the episode's ``tracker`` (None when the two do not line up)."""
-    import numpy as np
-
+def _excess_path(trajectory: Any, sources: Any, tracker: Any) -> dict[str, Any] | None:
+    """``metrics.excess_by_source`` over the driver's ``trajectory`` ((N + 1, 3), the result's) and
+    the behaviours its commands served (``sources``), measured by the episode's ``tracker`` (None
+    when the two do not line up)."""
     from hiconav.sim.metrics import excess_by_source
 
-    sources = list(getattr(driver, "sources", ()))
-    xy = np.asarray(driver.path, dtype=np.float64)[:, :2]
+    sources = list(sources)
+    xy = trajectory[:, :2]
     if len(xy) != len(sources) + 1:
         return None
     success_distance = float(tracker.sim.config.success_distance)
